@@ -1,0 +1,23 @@
+//! The `sylva` command line.
+
+use clap::{Parser, Subcommand};
+
+#[derive(Parser, Debug)]
+#[command(name = "sylva", version, about = "Grow trees in augmented reality")]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Option<Command>,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// One line per species preset, starting with its name.
+    Species,
+}
+
+pub fn main() -> anyhow::Result<()> {
+    let cli = Cli::parse();
+    match cli.command {
+        Some(Command::Species) | None => Ok(()),
+    }
+}

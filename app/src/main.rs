@@ -1,0 +1,3 @@
+fn main() -> anyhow::Result<()> {
+    sylva_app::cli::main()
+}

@@ -1,0 +1,1 @@
+//! (module environment: being written)

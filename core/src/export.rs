@@ -1,0 +1,1 @@
+//! (module export: being written)

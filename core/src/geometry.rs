@@ -1,0 +1,1 @@
+//! (module geometry: being written)

@@ -1,0 +1,1 @@
+//! (module growth: being written)

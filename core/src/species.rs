@@ -1,0 +1,1 @@
+//! (module species: being written)

@@ -1,0 +1,166 @@
+//! The tree: an arena of internodes (metamers) and their buds.
+//!
+//! Invariants (checked by [`Tree::sanity_check`]):
+//! - `internodes[0]` is the root (the base of the trunk) whenever the tree is not empty;
+//! - a parent always has a smaller index than its children (the arena is in topological order),
+//!   so a basipetal pass (tips → base) is a reverse loop and an acropetal pass a forward loop;
+//! - `parent` / `main_child` / `lateral_children` agree with each other;
+//! - a child starts where its parent ends.
+//!
+//! Space: world metres, Y up, the tree's base at `origin`.
+
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+use crate::rng::Rng;
+
+/// Index of an internode in [`Tree::internodes`].
+#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
+pub struct NodeId(pub u32);
+
+impl NodeId {
+    pub fn index(self) -> usize {
+        self.0 as usize
+    }
+}
+
+/// A bud: the meristem that may produce a new shoot.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Bud {
+    /// Unit direction a shoot from this bud starts in (world space).
+    pub direction: Vec3,
+    /// False once the bud has produced a shoot or was aborted.
+    pub alive: bool,
+}
+
+/// One metamer: an internode of fixed length with its buds.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Internode {
+    pub parent: Option<NodeId>,
+    /// The continuation of this axis (grown from the terminal bud), if any.
+    pub main_child: Option<NodeId>,
+    /// Shoots grown from this internode's lateral buds.
+    pub lateral_children: Vec<NodeId>,
+    /// Base of the internode, world metres.
+    pub start: Vec3,
+    /// Tip of the internode, world metres.
+    pub end: Vec3,
+    /// L axis of the HLU frame, parallel-transported along each axis from the root; unit,
+    /// perpendicular to the heading. U = H × L.
+    pub left: Vec3,
+    /// Diameter at the base of the internode (pipe model), metres.
+    pub diameter: f32,
+    /// Branch order: 0 on the trunk, +1 at every lateral branching.
+    pub order: u32,
+    /// Growth iteration in which this internode was created (0 = the seedling).
+    pub born_iteration: u32,
+    /// The terminal bud, present while this internode is a tip.
+    pub terminal_bud: Option<Bud>,
+    /// Lateral (axillary) buds of this metamer.
+    pub lateral_buds: Vec<Bud>,
+    /// A user width constraint (diameter, metres) set on this internode.
+    pub width_constraint: Option<f32>,
+    /// Light exposure L of this metamer's buds at the last iteration (0 = full shade).
+    pub light_exposure: f32,
+}
+
+impl Internode {
+    /// Unit heading H (start → end); +Y for a degenerate internode.
+    pub fn heading(&self) -> Vec3 {
+        (self.end - self.start).try_normalize().unwrap_or(Vec3::Y)
+    }
+
+    pub fn length(&self) -> f32 {
+        (self.end - self.start).length()
+    }
+
+    /// U axis of the HLU frame.
+    pub fn up(&self) -> Vec3 {
+        self.heading().cross(self.left)
+    }
+
+    /// All children, main continuation first.
+    pub fn children(&self) -> impl Iterator<Item = NodeId> + '_ {
+        self.main_child
+            .into_iter()
+            .chain(self.lateral_children.iter().copied())
+    }
+
+    pub fn is_tip(&self) -> bool {
+        self.main_child.is_none() && self.lateral_children.is_empty()
+    }
+}
+
+/// What [`Tree::sanity_check`] found wrong.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+pub enum TreeInvariantError {
+    #[error("internode {index}: {what}")]
+    Broken { index: usize, what: String },
+}
+
+/// The arena of internodes plus the generator that drives all randomness of this tree.
+///
+/// Growth state beyond the skeleton (species parameters, environment, history) is added by the
+/// modules that own it.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Skeleton {
+    pub internodes: Vec<Internode>,
+}
+
+impl Skeleton {
+    pub fn get(&self, id: NodeId) -> &Internode {
+        &self.internodes[id.index()]
+    }
+
+    pub fn len(&self) -> usize {
+        self.internodes.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.internodes.is_empty()
+    }
+
+    /// Checks the arena invariants listed in the module doc.
+    pub fn sanity_check(&self) -> Result<(), TreeInvariantError> {
+        let broken = |index: usize, what: String| Err(TreeInvariantError::Broken { index, what });
+        for (index, node) in self.internodes.iter().enumerate() {
+            for v in [node.start, node.end, node.left] {
+                if !v.is_finite() {
+                    return broken(index, format!("non-finite vector {v}"));
+                }
+            }
+            if !node.diameter.is_finite() || node.diameter < 0.0 {
+                return broken(index, format!("bad diameter {}", node.diameter));
+            }
+            match node.parent {
+                None if index != 0 => return broken(index, "no parent but not the root".into()),
+                Some(p) if p.index() >= index => {
+                    return broken(index, format!("parent {} not before child", p.0));
+                }
+                Some(p) => {
+                    let parent = &self.internodes[p.index()];
+                    let me = NodeId(index as u32);
+                    if !parent.children().any(|c| c == me) {
+                        return broken(index, format!("parent {} does not list it", p.0));
+                    }
+                    if parent.end.distance(node.start) > 1e-4 {
+                        return broken(index, "does not start at its parent's end".into());
+                    }
+                }
+                None => {}
+            }
+            for child in node.children() {
+                if child.index() >= self.internodes.len() {
+                    return broken(index, format!("child {} out of range", child.0));
+                }
+                if self.internodes[child.index()].parent != Some(NodeId(index as u32)) {
+                    return broken(index, format!("child {} has another parent", child.0));
+                }
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Shared by every module that needs per-tree randomness.
+pub type TreeRng = Rng;

@@ -1,0 +1,13 @@
+//! # sylva-tracking
+//!
+//! Camera tracking for Sylva's AR view: footage readers, a monocular tracker (frame, tracker,
+//! map), the RANSAC ground plane, metric scale and the scene depth mesh used for occlusion and
+//! for pruning a tree to the real scene.
+//!
+//! **Spaces.** `world_from_camera` maps camera coordinates (OpenCV convention: X right, Y down,
+//! Z forward, metres after scale is fixed) into the world: metres, Y up along the ground-plane
+//! normal, origin on the ground plane.
+//!
+//! **Features.** `opencv` (default on desktop): feature tracking, PnP and video readers through
+//! OpenCV; OpenCV types never leave the `cv` module. Without it, the plane, scale, map and depth
+//! mesh still build (mobile targets).
