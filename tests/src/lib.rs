@@ -8,7 +8,9 @@ use std::path::PathBuf;
 pub fn shared_data_dir() -> PathBuf {
     let dir = std::env::var_os("SYLVA_DATA")
         .map(PathBuf::from)
-        .unwrap_or_else(|| PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/test-data"));
+        .unwrap_or_else(|| {
+            PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../../shared/test-data")
+        });
     assert!(
         dir.is_dir(),
         "test data not found at {} (set SYLVA_DATA; the README says how to download the TUM sequences)",
