@@ -1,0 +1,57 @@
+//! Export of tree meshes for SketchUp, Blender, Lumion, Twinmotion, Unreal: binary glTF 2.0
+//! ([`write_glb`]) and Wavefront OBJ + MTL ([`write_obj`]).
+//!
+//! Both carry branches, leaves and fruit with their materials and the project's own procedural
+//! textures ([`crate::geometry::textures`]). Units are metres and Y is up, as glTF specifies and
+//! as Sylva's world space already is.
+//!
+//! glTF: one scene per level of detail (`LOD0` the default, then `LOD1`, `LOD2`), each a node
+//! with its own mesh; PBR metallic-roughness materials with embedded PNG textures; ambient light
+//! as `COLOR_0`. OBJ: the finest level only, textures written next to it.
+
+mod glb;
+mod obj;
+
+use std::path::{Path, PathBuf};
+
+pub use glb::{glb_bytes, write_glb};
+pub use obj::write_obj;
+
+/// Side length of the generated bark and leaf textures, pixels.
+pub const TEXTURE_SIZE: u32 = 256;
+
+/// What went wrong while exporting, naming the file.
+#[derive(Debug, thiserror::Error)]
+pub enum ExportError {
+    #[error("cannot write {path}: {source}")]
+    Io {
+        path: PathBuf,
+        #[source]
+        source: std::io::Error,
+    },
+    #[error("cannot encode {what} for {path}: {reason}")]
+    Encode {
+        path: PathBuf,
+        what: &'static str,
+        reason: String,
+    },
+    #[error("nothing to export to {path}: the tree has no triangles")]
+    Empty { path: PathBuf },
+    #[error("cannot export to {path}: {reason}")]
+    TooLarge { path: PathBuf, reason: String },
+}
+
+impl ExportError {
+    pub(crate) fn io(path: &Path) -> impl FnOnce(std::io::Error) -> ExportError + '_ {
+        move |source| ExportError::Io {
+            path: path.to_path_buf(),
+            source,
+        }
+    }
+}
+
+/// Ambient light (0..1) as the vertex colour multiplying the base colour: fully shaded parts keep
+/// a little light so they read as dark, not black.
+pub(crate) fn ambient_color(ambient: f32) -> f32 {
+    0.3 + 0.7 * ambient.clamp(0.0, 1.0)
+}

@@ -1,1 +1,0 @@
-//! (module geometry: being written)

@@ -1,0 +1,495 @@
+//! Branch meshes: generalized cylinders along the chains of the thickest-path topology.
+//!
+//! Ring frames (centre, tangent, transported reference, radius, texture coordinates, ambient)
+//! are computed once per tree; each level of detail then emits them with its own side counts.
+
+use std::f32::consts::{PI, TAU};
+
+use glam::Vec3;
+
+use super::topology::{BranchTopology, NONE};
+use super::{AmbientFn, BranchStart, MeshParams, TreeMesh, any_perpendicular, hash_unit};
+use crate::tree::{NodeId, Skeleton};
+
+/// A ring of a generalized cylinder.
+#[derive(Clone, Copy, Debug)]
+struct Ring {
+    center: Vec3,
+    tangent: Vec3,
+    /// Unit, perpendicular to `tangent`, carried by parallel transport along the chain.
+    reference: Vec3,
+    /// `tangent × reference`.
+    binormal: Vec3,
+    radius: f32,
+    /// Bark texture coordinates: v along the path, u offset (the per-segment rotation).
+    v: f32,
+    u_offset: f32,
+    ambient: f32,
+}
+
+/// The rings of one chain.
+#[derive(Clone, Copy, Debug)]
+struct ChainRings {
+    first_ring: u32,
+    /// Fewer than 2 means the chain has no visible geometry (it lies inside its parent).
+    num_rings: u32,
+    /// Sides C at the finest level (eq. C.2).
+    sides: u32,
+    /// Bark tiles around the circumference.
+    tiles_around: f32,
+}
+
+/// cos/sin of `k·2π/C` for k in 0..=C, for every side count C up to a maximum.
+struct SideTables {
+    offsets: Vec<usize>,
+    cos_sin: Vec<(f32, f32)>,
+}
+
+impl SideTables {
+    fn new(max_sides: u32) -> Self {
+        let mut offsets = vec![0; max_sides as usize + 1];
+        let mut cos_sin = Vec::new();
+        for sides in 3..=max_sides {
+            offsets[sides as usize] = cos_sin.len();
+            for k in 0..=sides {
+                let angle = TAU * k as f32 / sides as f32;
+                cos_sin.push((angle.cos(), angle.sin()));
+            }
+        }
+        SideTables { offsets, cos_sin }
+    }
+
+    fn get(&self, sides: u32) -> &[(f32, f32)] {
+        let start = self.offsets[sides as usize];
+        &self.cos_sin[start..start + sides as usize + 1]
+    }
+}
+
+pub(crate) struct RingFrames {
+    rings: Vec<Ring>,
+    chains: Vec<ChainRings>,
+    /// Chains sorted by base diameter, thickest first (parents before children on ties).
+    order_by_diameter: Vec<u32>,
+    tables: SideTables,
+    tip_taper: f32,
+}
+
+/// Sides C = 3·dⁿ/d_e (eq. C.2) of a branch of base diameter `d`, clamped to [3, max].
+fn contour_sides(diameter: f32, thinnest: f32, exponent: f32, max_sides: u32) -> u32 {
+    let sides = 3.0 * diameter.powf(exponent) / thinnest;
+    (sides.round() as u32).clamp(3, max_sides.max(3))
+}
+
+/// Sides of a chain at a level of detail drawn with `side_scale` of the finest sides.
+fn scaled_sides(sides: u32, side_scale: f32) -> u32 {
+    ((sides as f32 * side_scale).round() as u32).max(3)
+}
+
+/// Radius of the parent's tube at the ends of internode `node`, as the rings draw it.
+fn end_radius(skeleton: &Skeleton, topology: &BranchTopology, node: u32, tip_taper: f32) -> f32 {
+    let next = topology.visual_child[node as usize];
+    if next == NONE {
+        0.5 * skeleton.internodes[node as usize].diameter * tip_taper
+    } else {
+        0.5 * skeleton.internodes[next as usize].diameter
+    }
+}
+
+/// The parent surface near a branching point: the axis point closest to `point` on the two
+/// internodes around the joint (`parent` and its continuation), and the tube radius there.
+pub(crate) fn parent_surface_at(
+    skeleton: &Skeleton,
+    topology: &BranchTopology,
+    parent: u32,
+    tip_taper: f32,
+    point: Vec3,
+) -> (Vec3, f32) {
+    let continuation = topology.visual_child[parent as usize];
+    let below = &skeleton.internodes[parent as usize];
+    let mut best = closest_on_segment(
+        below.start,
+        below.end,
+        0.5 * below.diameter,
+        end_radius(skeleton, topology, parent, tip_taper),
+        point,
+    );
+    if continuation != NONE {
+        let above = &skeleton.internodes[continuation as usize];
+        let candidate = closest_on_segment(
+            above.start,
+            above.end,
+            0.5 * above.diameter,
+            end_radius(skeleton, topology, continuation, tip_taper),
+            point,
+        );
+        if candidate.0.distance_squared(point) < best.0.distance_squared(point) {
+            best = candidate;
+        }
+    }
+    best
+}
+
+fn closest_on_segment(a: Vec3, b: Vec3, radius_a: f32, radius_b: f32, point: Vec3) -> (Vec3, f32) {
+    let ab = b - a;
+    let length_squared = ab.length_squared();
+    let t = if length_squared > 1e-12 {
+        ((point - a).dot(ab) / length_squared).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (a + ab * t, radius_a + (radius_b - radius_a) * t)
+}
+
+/// Carries `reference` from a ring at `from` with tangent `from_tangent` to the next ring by the
+/// double-reflection rotation-minimizing frame (Wang et al. 2008).
+fn transport(reference: Vec3, from: Vec3, from_tangent: Vec3, to: Vec3, to_tangent: Vec3) -> Vec3 {
+    let v1 = to - from;
+    let c1 = v1.length_squared();
+    let (reflected_ref, reflected_tangent) = if c1 > 1e-14 {
+        (
+            reference - v1 * (2.0 / c1 * v1.dot(reference)),
+            from_tangent - v1 * (2.0 / c1 * v1.dot(from_tangent)),
+        )
+    } else {
+        (reference, from_tangent)
+    };
+    let v2 = to_tangent - reflected_tangent;
+    let c2 = v2.length_squared();
+    let out = if c2 > 1e-14 {
+        reflected_ref - v2 * (2.0 / c2 * v2.dot(reflected_ref))
+    } else {
+        reflected_ref
+    };
+    (out - to_tangent * out.dot(to_tangent))
+        .try_normalize()
+        .unwrap_or_else(|| any_perpendicular(to_tangent))
+}
+
+impl RingFrames {
+    pub(crate) fn build(
+        skeleton: &Skeleton,
+        topology: &BranchTopology,
+        params: &MeshParams,
+        ambient: AmbientFn,
+    ) -> Self {
+        let nodes = &skeleton.internodes;
+        let thinnest = nodes
+            .iter()
+            .map(|n| n.diameter)
+            .filter(|&d| d > 0.0)
+            .fold(f32::INFINITY, f32::min)
+            .clamp(1e-4, 1.0);
+        let max_sides = params.max_sides.max(3);
+        let mut rings = Vec::with_capacity(nodes.len() + topology.chains.len());
+        let mut chains = Vec::with_capacity(topology.chains.len());
+        for (chain_index, chain) in topology.chains.iter().enumerate() {
+            let chain_nodes = topology.nodes_of(chain_index);
+            let base_diameter = nodes[chain_nodes[0] as usize].diameter.max(1e-5);
+            let circumference = PI * base_diameter;
+            let tiles_around = (circumference / params.bark_tile_size.max(1e-4))
+                .round()
+                .max(1.0);
+            let first_ring = rings.len() as u32;
+            push_chain_rings(
+                &mut rings,
+                skeleton,
+                topology,
+                chain.parent_node,
+                chain_nodes,
+                params,
+                circumference / tiles_around,
+                ambient,
+            );
+            chains.push(ChainRings {
+                first_ring,
+                num_rings: rings.len() as u32 - first_ring,
+                sides: contour_sides(base_diameter, thinnest, params.side_exponent, max_sides),
+                tiles_around,
+            });
+        }
+        let mut keyed: Vec<u64> = topology
+            .chains
+            .iter()
+            .enumerate()
+            .map(|(index, chain)| {
+                let diameter = nodes[topology.chain_nodes[chain.first as usize] as usize].diameter;
+                // Non-negative floats order as their bits; invert for thickest first.
+                (u64::from(u32::MAX - diameter.max(0.0).to_bits()) << 32) | index as u64
+            })
+            .collect();
+        keyed.sort_unstable();
+        RingFrames {
+            rings,
+            chains,
+            order_by_diameter: keyed.into_iter().map(|k| k as u32).collect(),
+            tables: SideTables::new(max_sides),
+            tip_taper: params.tip_taper,
+        }
+    }
+
+    /// Triangles of the branches drawn with `side_scale` of the finest sides, all chains or the
+    /// `kept` ones.
+    pub(crate) fn num_triangles(
+        &self,
+        _topology: &BranchTopology,
+        side_scale: f32,
+        kept: Option<&[bool]>,
+    ) -> usize {
+        self.chains
+            .iter()
+            .enumerate()
+            .filter(|(index, _)| kept.is_none_or(|k| k[*index]))
+            .map(|(_, c)| chain_triangles(c, side_scale))
+            .sum()
+    }
+
+    /// The thickest chains whose triangles, with `side_scale`, fit in `budget`; a chain is only
+    /// kept with its parent, and the trunk always.
+    pub(crate) fn chains_within_budget(
+        &self,
+        topology: &BranchTopology,
+        side_scale: f32,
+        budget: usize,
+    ) -> Vec<bool> {
+        let mut kept = vec![false; self.chains.len()];
+        let mut used = 0usize;
+        for &index in &self.order_by_diameter {
+            let index = index as usize;
+            let parent = topology.chains[index].parent_chain;
+            if parent != NONE && !kept[parent as usize] {
+                continue;
+            }
+            let triangles = chain_triangles(&self.chains[index], side_scale);
+            if parent == NONE || used + triangles <= budget {
+                kept[index] = true;
+                used += triangles;
+            }
+        }
+        kept
+    }
+
+    /// Emits the branch mesh with `side_scale` of the finest sides, all chains or the `kept` ones.
+    pub(crate) fn mesh(
+        &self,
+        skeleton: &Skeleton,
+        topology: &BranchTopology,
+        side_scale: f32,
+        kept: Option<&[bool]>,
+    ) -> (TreeMesh, Vec<BranchStart>) {
+        let is_kept = |index: usize| kept.is_none_or(|k| k[index]);
+        let (mut num_vertices, mut num_indices) = (0, 0);
+        for (index, chain) in self.chains.iter().enumerate() {
+            if is_kept(index) && chain.num_rings >= 2 {
+                let sides = scaled_sides(chain.sides, side_scale) as usize;
+                num_vertices += (sides + 1) * chain.num_rings as usize;
+                num_indices += 6 * sides * (chain.num_rings as usize - 1);
+            }
+        }
+        let mut mesh = TreeMesh::with_capacity(num_vertices, num_indices);
+        let mut starts = Vec::new();
+        for (index, chain) in self.chains.iter().enumerate() {
+            if !is_kept(index) || chain.num_rings < 2 {
+                continue;
+            }
+            let sides = scaled_sides(chain.sides, side_scale);
+            let topo = topology.chains[index];
+            let parent = (topo.parent_node != NONE).then(|| {
+                let parent_sides =
+                    scaled_sides(self.chains[topo.parent_chain as usize].sides, side_scale);
+                (topo.parent_node, parent_sides)
+            });
+            starts.push(BranchStart {
+                node: NodeId(topology.chain_nodes[topo.first as usize]),
+                parent: parent.map(|(p, _)| (NodeId(p), NodeId(topology.visual_child[p as usize]))),
+                first_vertex: mesh.positions.len() as u32,
+                sides,
+            });
+            self.emit_chain(&mut mesh, skeleton, topology, chain, sides, parent);
+        }
+        debug_assert_eq!(mesh.positions.len(), num_vertices);
+        (mesh, starts)
+    }
+
+    fn emit_chain(
+        &self,
+        mesh: &mut TreeMesh,
+        skeleton: &Skeleton,
+        topology: &BranchTopology,
+        chain: &ChainRings,
+        sides: u32,
+        parent: Option<(u32, u32)>,
+    ) {
+        let table = self.tables.get(sides);
+        let rings =
+            &self.rings[chain.first_ring as usize..(chain.first_ring + chain.num_rings) as usize];
+        let du = chain.tiles_around / sides as f32;
+        for (ring_index, ring) in rings.iter().enumerate() {
+            let base = mesh.positions.len() as u32;
+            for (k, &(cos, sin)) in table.iter().enumerate() {
+                let direction = ring.reference * cos + ring.binormal * sin;
+                let mut position = ring.center + direction * ring.radius;
+                if ring_index == 0
+                    && let Some((parent_node, parent_sides)) = parent
+                {
+                    position = self.onto_parent(
+                        skeleton,
+                        topology,
+                        ring,
+                        direction,
+                        parent_node,
+                        parent_sides,
+                    );
+                }
+                let uv = [k as f32 * du + ring.u_offset, ring.v];
+                mesh.push_vertex(position, direction, uv, ring.ambient);
+            }
+            if ring_index > 0 {
+                let below = base - (sides + 1);
+                for k in 0..sides {
+                    let (a0, a1, b0, b1) = (below + k, below + k + 1, base + k, base + k + 1);
+                    mesh.indices.extend_from_slice(&[a0, a1, b1, a0, b1, b0]);
+                }
+            }
+        }
+    }
+
+    /// Lays a vertex of a lateral branch's first ring onto its parent's surface: slides it along
+    /// the branch tangent until it leaves the parent tube, then projects it radially onto the
+    /// tube (shrunk to the mid-radius of the parent's polygonal contour, so no gap shows).
+    fn onto_parent(
+        &self,
+        skeleton: &Skeleton,
+        topology: &BranchTopology,
+        ring: &Ring,
+        direction: Vec3,
+        parent_node: u32,
+        parent_sides: u32,
+    ) -> Vec3 {
+        let shrink = (0.5 * (1.0 + (PI / parent_sides as f32).cos())).max(0.96);
+        let start = ring.center + direction * ring.radius;
+        let surface = |p| parent_surface_at(skeleton, topology, parent_node, self.tip_taper, p);
+        let (_, joint_radius) = surface(ring.center);
+        let max_slide = 3.0 * joint_radius;
+        let mut slide = 0.0f32;
+        for _ in 0..3 {
+            let point = start + ring.tangent * slide;
+            let (axis, radius) = surface(point);
+            let offset = point - axis;
+            let distance = offset.length();
+            let gap = radius * shrink - distance;
+            if gap <= 1e-4 * radius || distance < 1e-9 {
+                break;
+            }
+            let rate = ring.tangent.dot(offset / distance).max(0.25);
+            slide = (slide + gap / rate).min(max_slide);
+        }
+        let point = start + ring.tangent * slide;
+        let (axis, radius) = surface(point);
+        let outward = (point - axis)
+            .try_normalize()
+            .or_else(|| direction.try_normalize())
+            .unwrap_or(Vec3::X);
+        axis + outward * radius * shrink
+    }
+}
+
+fn chain_triangles(chain: &ChainRings, side_scale: f32) -> usize {
+    if chain.num_rings < 2 {
+        return 0;
+    }
+    2 * scaled_sides(chain.sides, side_scale) as usize * (chain.num_rings as usize - 1)
+}
+
+/// Appends the rings of one chain: a ring at the start of every internode and one at the tip.
+/// A lateral chain's first ring sits at the branching point (it is laid onto the parent surface
+/// when emitted); the following rings that still lie inside the parent tube are dropped.
+#[allow(clippy::too_many_arguments)]
+fn push_chain_rings(
+    rings: &mut Vec<Ring>,
+    skeleton: &Skeleton,
+    topology: &BranchTopology,
+    parent_node: u32,
+    chain_nodes: &[u32],
+    params: &MeshParams,
+    tile_length: f32,
+    ambient: AmbientFn,
+) {
+    let nodes = &skeleton.internodes;
+    let first = &nodes[chain_nodes[0] as usize];
+    let mut previous = Ring {
+        center: first.start,
+        tangent: first.heading(),
+        reference: Vec3::ZERO,
+        binormal: Vec3::ZERO,
+        radius: 0.5 * first.diameter,
+        v: 0.0,
+        u_offset: 0.0,
+        ambient: ambient(first.start).clamp(0.0, 1.0),
+    };
+    previous.reference = (first.left - previous.tangent * first.left.dot(previous.tangent))
+        .try_normalize()
+        .unwrap_or_else(|| any_perpendicular(previous.tangent));
+    previous.binormal = previous.tangent.cross(previous.reference);
+    if parent_node != NONE {
+        let (_, joint_radius) = parent_surface_at(
+            skeleton,
+            topology,
+            parent_node,
+            params.tip_taper,
+            first.start,
+        );
+        previous.radius = previous.radius.min(0.85 * joint_radius);
+    }
+    rings.push(previous);
+    let mut inside_parent = parent_node != NONE;
+    let mut arc_length = 0.0;
+    for (k, &node_index) in chain_nodes.iter().enumerate() {
+        let node = &nodes[node_index as usize];
+        let heading = node.heading();
+        arc_length += node.length();
+        let (tangent, radius) = match chain_nodes.get(k + 1) {
+            Some(&next) => {
+                let next = &nodes[next as usize];
+                (
+                    (heading + next.heading())
+                        .try_normalize()
+                        .unwrap_or(heading),
+                    0.5 * next.diameter,
+                )
+            }
+            None => (heading, 0.5 * node.diameter * params.tip_taper),
+        };
+        if inside_parent {
+            let (axis, parent_radius) =
+                parent_surface_at(skeleton, topology, parent_node, params.tip_taper, node.end);
+            if node.end.distance(axis) < parent_radius {
+                continue;
+            }
+            inside_parent = false;
+        }
+        let reference = transport(
+            previous.reference,
+            previous.center,
+            previous.tangent,
+            node.end,
+            tangent,
+        );
+        let twist = params.bark_twist * (2.0 * hash_unit(u64::from(node_index)) - 1.0);
+        let ring = Ring {
+            center: node.end,
+            tangent,
+            reference,
+            binormal: tangent.cross(reference),
+            radius,
+            v: arc_length / tile_length,
+            u_offset: previous.u_offset + twist,
+            ambient: ambient(node.end).clamp(0.0, 1.0),
+        };
+        rings.push(ring);
+        previous = ring;
+    }
+    if inside_parent {
+        // The whole branch hides inside its parent: no geometry.
+        rings.pop();
+    }
+}

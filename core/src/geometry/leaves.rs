@@ -1,0 +1,291 @@
+//! Leaves and fruit (Longay 2014, appendices C.1 and C.2).
+//!
+//! Leaves sit on every branch thinner than a threshold, at a density and size of their own
+//! (C.1.1), in a phyllotactic spiral. Each leaf hangs from a petiole, an inextensible rod whose
+//! frame H, L, U turns at the rates (C.1.2)
+//! Ω_H = −e_H L·T (twist), Ω_L = e_L H·T (bend), Ω_U = e_U L·(T × (H × T)) (turn),
+//! integrated proximal to distal in steps Δs; the blade at its end lies in the H–L plane with
+//! normal U. The target T is the light direction and the rates scale with the leaf's ambient
+//! light, so sunlit leaves turn their blade to the light and shaded ones keep their phyllotaxis.
+//!
+//! The leaf buffer is in random order, so a prefix of it is an even thinning of the crown: the
+//! levels of detail draw prefixes.
+
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+use super::{AmbientFn, TreeMesh, any_perpendicular, hash_unit};
+use crate::rng::Rng;
+use crate::tree::Skeleton;
+
+/// The golden angle, radians: the phyllotactic divergence between successive leaves.
+const GOLDEN_ANGLE: f32 = 2.399_963;
+
+/// Leaf placement, size and orientation. Lengths in metres, angles in radians.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct LeafParams {
+    /// Leaves grow on internodes thinner than this diameter.
+    pub max_branch_diameter: f32,
+    /// Leaves per metre of leaf-bearing branch (density).
+    pub leaves_per_metre: f32,
+    /// Blade length (along the petiole) and width.
+    pub length: f32,
+    pub width: f32,
+    /// Petiole length S.
+    pub petiole_length: f32,
+    /// Integration steps along the petiole (Δs = S / steps).
+    pub petiole_steps: u32,
+    /// Angle between the branch and a petiole as it leaves the branch.
+    pub insertion_angle: f32,
+    /// Twist rate e_H, bend rate e_L and turn rate e_U, per metre of petiole, in full light.
+    pub twist_rate: f32,
+    pub bend_rate: f32,
+    pub turn_rate: f32,
+    /// Tropism target T of the blade normal: towards the light.
+    pub light_direction: [f32; 3],
+}
+
+impl Default for LeafParams {
+    fn default() -> Self {
+        LeafParams {
+            max_branch_diameter: 0.02,
+            leaves_per_metre: 30.0,
+            length: 0.08,
+            width: 0.05,
+            petiole_length: 0.03,
+            petiole_steps: 4,
+            insertion_angle: 0.9,
+            twist_rate: 90.0,
+            bend_rate: 40.0,
+            turn_rate: 10.0,
+            light_direction: [0.0, 1.0, 0.0],
+        }
+    }
+}
+
+/// Fruit (or flowers) on the buds of thin branches, by p = r·L² (eq. C.1).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FruitParams {
+    /// A bud bears fruit when p = r·L² exceeds this threshold (0..1).
+    pub threshold: f32,
+    /// Only buds of internodes thinner than this diameter, metres.
+    pub max_branch_diameter: f32,
+    /// Fruit radius, metres.
+    pub radius: f32,
+    /// Rotation of the bud frame towards the ground (the thesis's Droop), radians.
+    pub droop: f32,
+}
+
+impl Default for FruitParams {
+    fn default() -> Self {
+        FruitParams {
+            threshold: 0.5,
+            max_branch_diameter: 0.015,
+            radius: 0.035,
+            droop: 1.2,
+        }
+    }
+}
+
+/// A leaf to be made: the internode, position along it (0..1) and spiral angle.
+#[derive(Clone, Copy)]
+struct LeafSlot {
+    node: u32,
+    along: f32,
+    angle: f32,
+}
+
+/// All leaves of the skeleton as quads (4 vertices, 6 indices each) in random order.
+pub fn build_leaves(
+    skeleton: &Skeleton,
+    params: &LeafParams,
+    seed: u64,
+    ambient: AmbientFn,
+) -> TreeMesh {
+    let mut slots = Vec::new();
+    let mut spiral = 0.0f32;
+    for (index, node) in skeleton.internodes.iter().enumerate() {
+        if node.diameter >= params.max_branch_diameter {
+            continue;
+        }
+        let expected = params.leaves_per_metre * node.length();
+        let jitter = hash_unit(seed ^ ((index as u64) << 20));
+        let count = (expected + jitter) as u32;
+        for k in 0..count {
+            spiral = (spiral + GOLDEN_ANGLE) % std::f32::consts::TAU;
+            slots.push(LeafSlot {
+                node: index as u32,
+                along: (k as f32 + 0.5) / count as f32,
+                angle: spiral,
+            });
+        }
+    }
+    let mut rng = Rng::new(seed ^ 0x1eaf);
+    for i in (1..slots.len()).rev() {
+        let j = rng.below(i as u32 + 1) as usize;
+        slots.swap(i, j);
+    }
+    let mut mesh = TreeMesh::with_capacity(slots.len() * 4, slots.len() * 6);
+    let target = Vec3::from(params.light_direction)
+        .try_normalize()
+        .unwrap_or(Vec3::Y);
+    for slot in &slots {
+        push_leaf(&mut mesh, skeleton, params, target, slot, ambient);
+    }
+    mesh
+}
+
+fn push_leaf(
+    mesh: &mut TreeMesh,
+    skeleton: &Skeleton,
+    params: &LeafParams,
+    target: Vec3,
+    slot: &LeafSlot,
+    ambient: AmbientFn,
+) {
+    let node = &skeleton.internodes[slot.node as usize];
+    let heading = node.heading();
+    let left = (node.left - heading * node.left.dot(heading))
+        .try_normalize()
+        .unwrap_or_else(|| any_perpendicular(heading));
+    let up = heading.cross(left);
+    let (sin_a, cos_a) = slot.angle.sin_cos();
+    let radial = left * cos_a + up * sin_a;
+    let attachment = node.start.lerp(node.end, slot.along) + radial * (0.5 * node.diameter);
+    let light = ambient(attachment).clamp(0.0, 1.0);
+    let (sin_i, cos_i) = params.insertion_angle.sin_cos();
+    let mut h = heading * cos_i + radial * sin_i;
+    let mut l = heading.cross(radial).try_normalize().unwrap_or(left);
+    let steps = params.petiole_steps.max(1);
+    let ds = params.petiole_length / steps as f32;
+    let mut position = attachment;
+    for _ in 0..steps {
+        let u = h.cross(l);
+        let omega_h = -params.twist_rate * l.dot(target);
+        let omega_l = params.bend_rate * h.dot(target);
+        let omega_u = params.turn_rate * l.dot(target.cross(h.cross(target)));
+        let omega = (h * omega_h + l * omega_l + u * omega_u) * light;
+        let angle = omega.length() * ds;
+        if angle > 1e-6 {
+            let axis = omega / omega.length();
+            h = rotate(h, axis, angle);
+            l = rotate(l, axis, angle);
+        }
+        position += h * ds;
+    }
+    let h = h.try_normalize().unwrap_or(heading);
+    let l = (l - h * l.dot(h))
+        .try_normalize()
+        .unwrap_or_else(|| any_perpendicular(h));
+    let normal = h.cross(l);
+    let half_width = l * (0.5 * params.width);
+    let tip = position + h * params.length;
+    let base = mesh.positions.len() as u32;
+    mesh.push_vertex(position - half_width, normal, [0.0, 1.0], light);
+    mesh.push_vertex(position + half_width, normal, [1.0, 1.0], light);
+    mesh.push_vertex(tip - half_width, normal, [0.0, 0.0], light);
+    mesh.push_vertex(tip + half_width, normal, [1.0, 0.0], light);
+    // Counter-clockwise seen from the normal's side (H × L = U): base-left, tip-left, tip-right.
+    mesh.indices
+        .extend_from_slice(&[base, base + 2, base + 3, base, base + 3, base + 1]);
+}
+
+/// Rotation of `v` about unit `axis` by `angle` (Rodrigues).
+fn rotate(v: Vec3, axis: Vec3, angle: f32) -> Vec3 {
+    let (sin, cos) = angle.sin_cos();
+    v * cos + axis.cross(v) * sin + axis * (axis.dot(v) * (1.0 - cos))
+}
+
+/// Fruit on the alive buds of thin internodes with p = r·L² above the threshold (eq. C.1):
+/// L is the internode's light exposure, r a hash of the bud position. Each fruit is an
+/// icosahedron hanging from its bud, the bud direction rotated down by the droop angle.
+pub fn build_fruit(skeleton: &Skeleton, params: &FruitParams, ambient: AmbientFn) -> TreeMesh {
+    let mut mesh = TreeMesh::default();
+    for (index, node) in skeleton.internodes.iter().enumerate() {
+        if node.diameter >= params.max_branch_diameter {
+            continue;
+        }
+        let light = node.light_exposure.clamp(0.0, 1.0);
+        let buds = node.terminal_bud.iter().chain(node.lateral_buds.iter());
+        for (k, bud) in buds.enumerate().filter(|(_, b)| b.alive) {
+            let r = hash_unit(position_hash(node.end) ^ ((k as u64) << 48) ^ index as u64);
+            if r * light * light <= params.threshold {
+                continue;
+            }
+            let down = droop(bud.direction, params.droop);
+            let center = node.end + down * (params.radius * 1.2);
+            push_icosahedron(
+                &mut mesh,
+                center,
+                params.radius,
+                ambient(center).clamp(0.0, 1.0),
+            );
+        }
+    }
+    mesh
+}
+
+/// Bud direction rotated towards −Y by `angle` (not past straight down).
+fn droop(direction: Vec3, angle: f32) -> Vec3 {
+    let direction = direction.try_normalize().unwrap_or(Vec3::Y);
+    let to_down = direction.angle_between(Vec3::NEG_Y);
+    match direction.cross(Vec3::NEG_Y).try_normalize() {
+        Some(axis) => rotate(direction, axis, angle.min(to_down)),
+        None => direction,
+    }
+}
+
+/// Hash of a position quantised to 0.1 mm (the thesis XORs the components into a table index).
+fn position_hash(p: Vec3) -> u64 {
+    let q = |x: f32| (x * 1.0e4).round() as i64 as u64;
+    q(p.x).wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ q(p.y).rotate_left(21) ^ q(p.z).rotate_left(42)
+}
+
+fn push_icosahedron(mesh: &mut TreeMesh, center: Vec3, radius: f32, light: f32) {
+    const PHI: f32 = 1.618_034;
+    const CORNERS: [[f32; 3]; 12] = [
+        [-1.0, PHI, 0.0],
+        [1.0, PHI, 0.0],
+        [-1.0, -PHI, 0.0],
+        [1.0, -PHI, 0.0],
+        [0.0, -1.0, PHI],
+        [0.0, 1.0, PHI],
+        [0.0, -1.0, -PHI],
+        [0.0, 1.0, -PHI],
+        [PHI, 0.0, -1.0],
+        [PHI, 0.0, 1.0],
+        [-PHI, 0.0, -1.0],
+        [-PHI, 0.0, 1.0],
+    ];
+    const FACES: [[u32; 3]; 20] = [
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
+    ];
+    let base = mesh.positions.len() as u32;
+    for corner in CORNERS {
+        let normal = Vec3::from(corner).normalize();
+        let uv = [0.5 + 0.5 * normal.x, 0.5 - 0.5 * normal.y];
+        mesh.push_vertex(center + normal * radius, normal, uv, light);
+    }
+    for face in FACES {
+        mesh.indices.extend(face.iter().map(|&i| base + i));
+    }
+}

@@ -1,0 +1,289 @@
+//! Branch, leaf and fruit meshes of a tree skeleton, with levels of detail (Longay 2014,
+//! appendix C; Pirk 2014, ch. 6).
+//!
+//! - **Branches** are generalized cylinders: one ring per internode joint, oriented along the
+//!   joint's tangent with a reference vector carried by parallel transport (double reflection),
+//!   so rings never twist. The topology is first reorganised along the thickest path (appendix
+//!   C.3, [`topology`]) and the first ring of every lateral branch is laid onto its parent's
+//!   surface, so dominant laterals leave no cracks. Sides per branch C = 3·dⁿ/d_e (eq. C.2).
+//!   Bark UVs are tiled along the path with a small rotation per segment; normals are smooth.
+//! - **Leaves** ([`leaves`]) are alpha-textured quads on branches thinner than a threshold,
+//!   oriented by the petiole model of appendix C.1.2; sunlit leaves turn their blade to the light.
+//! - **Fruit** grows on buds with p = r·L² above a threshold (appendix C.2).
+//! - **Ambient**: every vertex carries the ambient light of the growth shadow grid, sampled
+//!   through a callback so this module does not depend on growth.
+//! - **Levels of detail** ([`Lod`]): about 100%, 40% and 15% of the triangles, by fewer sides,
+//!   dropping the thinnest branches and drawing a prefix of the randomly ordered leaf buffer.
+//!
+//! Space: world metres, Y up, as the skeleton. All arrays are flat `[f32; N]` / `u32` vectors, ready
+//! to be cast to GPU buffers.
+
+mod branches;
+pub mod leaves;
+pub mod synthetic;
+pub mod textures;
+pub mod topology;
+
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+use crate::tree::{NodeId, Skeleton};
+
+pub use leaves::{FruitParams, LeafParams};
+pub use topology::BranchTopology;
+
+/// Ambient light at a world point: 1 = unshaded sky, 0 = full shade.
+pub type AmbientFn<'a> = &'a dyn Fn(Vec3) -> f32;
+
+/// Fractions of the full triangle count aimed at by the three levels of detail.
+pub const LOD_TRIANGLE_FRACTIONS: [f32; 3] = [1.0, 0.4, 0.15];
+
+/// Parameters of the tree mesh. Lengths in metres.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MeshParams {
+    /// Most sides a branch contour gets at the finest level of detail.
+    pub max_sides: u32,
+    /// Exponent n of C = 3·dⁿ/d_e (eq. C.2), diameters in metres; n > 1 gives thick branches
+    /// fewer sides.
+    pub side_exponent: f32,
+    /// Side length of one square bark texture tile on a thick branch.
+    pub bark_tile_size: f32,
+    /// Largest rotation of the bark texture from one segment to the next, in turns.
+    pub bark_twist: f32,
+    /// Radius at a branch tip relative to the radius at the base of its last internode.
+    pub tip_taper: f32,
+    pub leaves: LeafParams,
+    /// Fruit or flowers; `None` for none.
+    pub fruit: Option<FruitParams>,
+    /// Linear RGB of the bark texture, leaf texture and fruit.
+    pub bark_color: [f32; 3],
+    pub leaf_color: [f32; 3],
+    pub fruit_color: [f32; 3],
+    /// Seed of the leaf order and placement jitter.
+    pub seed: u64,
+}
+
+impl Default for MeshParams {
+    fn default() -> Self {
+        MeshParams {
+            max_sides: 24,
+            side_exponent: 1.0,
+            bark_tile_size: 0.25,
+            bark_twist: 0.02,
+            tip_taper: 0.5,
+            leaves: LeafParams::default(),
+            fruit: None,
+            bark_color: [0.22, 0.16, 0.11],
+            leaf_color: [0.16, 0.36, 0.08],
+            fruit_color: [0.65, 0.06, 0.04],
+            seed: 1,
+        }
+    }
+}
+
+/// An indexed triangle mesh with the attributes every tree part carries.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TreeMesh {
+    /// World metres.
+    pub positions: Vec<[f32; 3]>,
+    /// Unit normals.
+    pub normals: Vec<[f32; 3]>,
+    pub uvs: Vec<[f32; 2]>,
+    /// Ambient light per vertex, 0..1.
+    pub ambient: Vec<f32>,
+    /// Triangles, counter-clockwise seen from outside.
+    pub indices: Vec<u32>,
+}
+
+impl TreeMesh {
+    pub fn with_capacity(num_vertices: usize, num_indices: usize) -> Self {
+        TreeMesh {
+            positions: Vec::with_capacity(num_vertices),
+            normals: Vec::with_capacity(num_vertices),
+            uvs: Vec::with_capacity(num_vertices),
+            ambient: Vec::with_capacity(num_vertices),
+            indices: Vec::with_capacity(num_indices),
+        }
+    }
+
+    pub fn num_vertices(&self) -> usize {
+        self.positions.len()
+    }
+
+    pub fn num_triangles(&self) -> usize {
+        self.indices.len() / 3
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.indices.is_empty()
+    }
+
+    pub(crate) fn push_vertex(&mut self, position: Vec3, normal: Vec3, uv: [f32; 2], ambient: f32) {
+        self.positions.push(position.to_array());
+        self.normals.push(normal.to_array());
+        self.uvs.push(uv);
+        self.ambient.push(ambient);
+    }
+
+    /// Axis-aligned bounds (min, max) of the vertices used by the first `num_indices` indices;
+    /// `None` when there are none.
+    pub fn bounds_of_prefix(&self, num_indices: usize) -> Option<(Vec3, Vec3)> {
+        let used = &self.indices[..num_indices.min(self.indices.len())];
+        let mut iter = used.iter().map(|&i| Vec3::from(self.positions[i as usize]));
+        let first = iter.next()?;
+        Some(iter.fold((first, first), |(lo, hi), p| (lo.min(p), hi.max(p))))
+    }
+
+    /// Bounds of the whole mesh.
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        self.bounds_of_prefix(self.indices.len())
+    }
+
+    /// Number of vertices used by the first `num_indices` indices, for buffers whose triangles
+    /// are stored in vertex order (leaves, fruit): the largest index plus one.
+    pub fn num_vertices_of_prefix(&self, num_indices: usize) -> usize {
+        self.indices[..num_indices.min(self.indices.len())]
+            .iter()
+            .max()
+            .map_or(0, |&m| m as usize + 1)
+    }
+}
+
+/// Where a branch (a chain of the thickest-path topology) starts in a branch mesh.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BranchStart {
+    /// First internode of the branch.
+    pub node: NodeId,
+    /// The internode whose end the branch grows from, and that internode's continuation along
+    /// the thickest path; `None` for the trunk.
+    pub parent: Option<(NodeId, NodeId)>,
+    /// Index of the first vertex of the branch's first ring; the ring has `sides + 1` vertices
+    /// (the last repeats the first with u = 1).
+    pub first_vertex: u32,
+    pub sides: u32,
+}
+
+/// One level of detail.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Lod {
+    /// Fraction of the finest level's triangles this level aims at.
+    pub target_fraction: f32,
+    pub branches: TreeMesh,
+    pub branch_starts: Vec<BranchStart>,
+    /// This level draws the first `num_leaf_indices` of [`TreeMeshes::leaves`].
+    pub num_leaf_indices: usize,
+    /// This level draws the first `num_fruit_indices` of [`TreeMeshes::fruit`].
+    pub num_fruit_indices: usize,
+}
+
+impl Lod {
+    pub fn num_triangles(&self) -> usize {
+        self.branches.num_triangles() + (self.num_leaf_indices + self.num_fruit_indices) / 3
+    }
+}
+
+/// Colours of the materials, linear RGB.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct MaterialColors {
+    pub bark: [f32; 3],
+    pub leaf: [f32; 3],
+    pub fruit: [f32; 3],
+}
+
+/// Every mesh of a tree: branches per level of detail, one randomly ordered leaf buffer and one
+/// fruit buffer whose prefixes the levels draw.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TreeMeshes {
+    /// Finest first.
+    pub lods: Vec<Lod>,
+    /// Quads of 4 vertices and 6 indices each, in random order.
+    pub leaves: TreeMesh,
+    /// Fruit meshes in random order.
+    pub fruit: TreeMesh,
+    pub colors: MaterialColors,
+}
+
+impl TreeMeshes {
+    /// Triangles drawn at level `lod`; 0 for a level that does not exist.
+    pub fn num_triangles(&self, lod: usize) -> usize {
+        self.lods.get(lod).map_or(0, Lod::num_triangles)
+    }
+
+    /// Bounds of everything drawn at level `lod`.
+    pub fn bounds(&self, lod: usize) -> Option<(Vec3, Vec3)> {
+        let level = self.lods.get(lod)?;
+        [
+            level.branches.bounds(),
+            self.leaves.bounds_of_prefix(level.num_leaf_indices),
+            self.fruit.bounds_of_prefix(level.num_fruit_indices),
+        ]
+        .into_iter()
+        .flatten()
+        .reduce(|(a0, a1), (b0, b1)| (a0.min(b0), a1.max(b1)))
+    }
+}
+
+/// Builds the branch, leaf and fruit meshes of `skeleton` at the three levels of detail of
+/// [`LOD_TRIANGLE_FRACTIONS`], sampling `ambient` once per ring, leaf and fruit.
+pub fn build_meshes(skeleton: &Skeleton, params: &MeshParams, ambient: AmbientFn) -> TreeMeshes {
+    let topology = BranchTopology::build(skeleton);
+    let rings = branches::RingFrames::build(skeleton, &topology, params, ambient);
+    let leaves = leaves::build_leaves(skeleton, &params.leaves, params.seed, ambient);
+    let fruit = match &params.fruit {
+        Some(fruit) => leaves::build_fruit(skeleton, fruit, ambient),
+        None => TreeMesh::default(),
+    };
+    let num_branch_triangles_full = rings.num_triangles(&topology, 1.0, None);
+    let lods = LOD_TRIANGLE_FRACTIONS
+        .iter()
+        .map(|&fraction| {
+            let (branches, branch_starts) = if fraction >= 1.0 {
+                rings.mesh(skeleton, &topology, 1.0, None)
+            } else {
+                let target = (num_branch_triangles_full as f32 * fraction) as usize;
+                let side_scale = fraction.sqrt();
+                let kept = rings.chains_within_budget(&topology, side_scale, target);
+                rings.mesh(skeleton, &topology, side_scale, Some(&kept))
+            };
+            Lod {
+                target_fraction: fraction,
+                branches,
+                branch_starts,
+                num_leaf_indices: prefix_indices(leaves.indices.len(), 6, fraction),
+                num_fruit_indices: prefix_indices(fruit.indices.len(), 3, fraction),
+            }
+        })
+        .collect();
+    TreeMeshes {
+        lods,
+        leaves,
+        fruit,
+        colors: MaterialColors {
+            bark: params.bark_color,
+            leaf: params.leaf_color,
+            fruit: params.fruit_color,
+        },
+    }
+}
+
+/// The number of indices of a `fraction` prefix, rounded to whole primitives of `unit` indices.
+fn prefix_indices(num_indices: usize, unit: usize, fraction: f32) -> usize {
+    let units = num_indices / unit;
+    ((units as f32 * fraction).round() as usize).min(units) * unit
+}
+
+/// Deterministic hash of an integer to [0, 1): placement jitter and the fruit lottery r.
+pub(crate) fn hash_unit(mut x: u64) -> f32 {
+    x ^= x >> 33;
+    x = x.wrapping_mul(0xff51_afd7_ed55_8ccd);
+    x ^= x >> 33;
+    x = x.wrapping_mul(0xc4ce_b9fe_1a85_ec53);
+    x ^= x >> 33;
+    (x >> 40) as f32 * (1.0 / 16_777_216.0)
+}
+
+/// Any unit vector perpendicular to unit `v`.
+pub(crate) fn any_perpendicular(v: Vec3) -> Vec3 {
+    let other = if v.x.abs() < 0.9 { Vec3::X } else { Vec3::Z };
+    v.cross(other).try_normalize().unwrap_or(Vec3::Z)
+}

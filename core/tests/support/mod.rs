@@ -1,0 +1,121 @@
+//! Helpers shared by the export tests: the Khronos validator and the re-import check.
+
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+use sylva_core::geometry::TreeMeshes;
+
+pub struct ValidatorReport {
+    pub num_errors: u64,
+    pub num_warnings: u64,
+    pub text: String,
+}
+
+fn workspace_root() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("..")
+}
+
+/// Runs `node tools/gltf-validator/validate.js` on `path`. Panics, loudly, when node or the
+/// validator package is missing: the check must never be skipped silently.
+pub fn validate_glb(path: &Path) -> ValidatorReport {
+    let script = workspace_root().join("tools/gltf-validator/validate.js");
+    let package = workspace_root().join("tools/gltf-validator/node_modules/gltf-validator");
+    assert!(
+        package.is_dir(),
+        "the Khronos glTF validator is not installed: run `bash scripts/setup.sh` \
+         (npm install in tools/gltf-validator)"
+    );
+    let output = Command::new("node")
+        .arg(&script)
+        .arg(path)
+        .output()
+        .unwrap_or_else(|e| panic!("cannot run node (needed for the glTF validator): {e}"));
+    let text = String::from_utf8_lossy(&output.stdout).into_owned();
+    let report: serde_json::Value = serde_json::from_str(&text).unwrap_or_else(|e| {
+        panic!(
+            "validator gave no JSON report for {} ({e}); stderr: {}",
+            path.display(),
+            String::from_utf8_lossy(&output.stderr)
+        )
+    });
+    let issues = &report["issues"];
+    let count = |key: &str| {
+        issues[key]
+            .as_u64()
+            .unwrap_or_else(|| panic!("report lacks issues.{key}"))
+    };
+    let num_errors = count("numErrors");
+    assert_eq!(
+        output.status.success(),
+        num_errors == 0,
+        "validator exit status disagrees with its report"
+    );
+    ValidatorReport {
+        num_errors,
+        num_warnings: count("numWarnings"),
+        text,
+    }
+}
+
+/// Re-imports `path` with the `gltf` crate and checks, per level of detail (one scene each),
+/// the triangle count and bounds against `meshes`, plus textured bark and leaf materials.
+pub fn assert_reimport_matches(path: &Path, meshes: &TreeMeshes) {
+    let (document, buffers, images) = gltf::import(path).expect("the glb imports");
+    assert_eq!(
+        document.scenes().count(),
+        meshes.lods.len(),
+        "one scene per level of detail"
+    );
+    assert_eq!(document.default_scene().map(|s| s.index()), Some(0));
+    for (level, scene) in document.scenes().enumerate() {
+        let mut triangles = 0;
+        let mut lo = glam::Vec3::splat(f32::INFINITY);
+        let mut hi = glam::Vec3::splat(f32::NEG_INFINITY);
+        for node in scene.nodes() {
+            let mesh = node.mesh().expect("a mesh per level");
+            for primitive in mesh.primitives() {
+                let reader = primitive.reader(|b| Some(&buffers[b.index()]));
+                triangles += reader.read_indices().expect("indexed").into_u32().count() / 3;
+                let positions: Vec<[f32; 3]> =
+                    reader.read_positions().expect("positions").collect();
+                assert!(reader.read_normals().is_some() && reader.read_tex_coords(0).is_some());
+                for p in positions {
+                    lo = lo.min(p.into());
+                    hi = hi.max(p.into());
+                }
+            }
+        }
+        assert_eq!(
+            triangles,
+            meshes.num_triangles(level),
+            "LOD{level} triangles"
+        );
+        let (expected_lo, expected_hi) = meshes.bounds(level).expect("bounds");
+        assert!(
+            lo.abs_diff_eq(expected_lo, 1e-6) && hi.abs_diff_eq(expected_hi, 1e-6),
+            "LOD{level} bounds"
+        );
+    }
+    let material = |name: &str| {
+        document
+            .materials()
+            .find(|m| m.name() == Some(name))
+            .unwrap_or_else(|| panic!("no {name} material"))
+    };
+    let leaf = material("leaf");
+    assert!(
+        leaf.pbr_metallic_roughness().base_color_texture().is_some(),
+        "leaf texture"
+    );
+    assert_eq!(leaf.alpha_mode(), gltf::material::AlphaMode::Mask);
+    assert!(
+        material("bark")
+            .pbr_metallic_roughness()
+            .base_color_texture()
+            .is_some(),
+        "bark texture"
+    );
+    assert!(meshes.leaves.num_triangles() > 0, "the tree has leaves");
+    assert_eq!(images.len(), 2, "bark and leaf images");
+    assert!(images.iter().all(|i| i.width >= 64 && i.height >= 64));
+}
