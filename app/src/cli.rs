@@ -13,11 +13,15 @@ pub struct Cli {
 pub enum Command {
     /// One line per species preset, starting with its name.
     Species,
+    /// Grows a tree autonomously and saves it; ends with a key=value summary line.
+    Grow(crate::cmd_grow::GrowArgs),
 }
 
 pub fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
     match cli.command {
-        Some(Command::Species) | None => Ok(()),
+        Some(Command::Species) => crate::cmd_grow::species(),
+        Some(Command::Grow(args)) => crate::cmd_grow::grow(args),
+        None => Ok(()),
     }
 }

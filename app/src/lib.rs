@@ -4,3 +4,4 @@
 //! UI, sessions and the command line.
 
 pub mod cli;
+pub mod cmd_grow;

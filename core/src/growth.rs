@@ -1,1 +1,370 @@
-//! (module growth: being written)
+//! Self-organizing growth (Pałubicki et al. 2009; Longay 2014 ch. 4), one iteration (one season)
+//! at a time, step by step in the thesis' order:
+//!
+//! 1. light: bud exposure L = max(C − s + a, 0) from the shadow grid ([`light`]);
+//! 2. competition for space: attraction points, occupancy spheres, perception cones ([`space`]);
+//! 3. bud input Q = b·L^κ with gravimorphism b ([`light`]);
+//! 4. vigor: extended Borchert–Honda, basipetal then acropetal ([`vigor`]);
+//! 5. and 6. shoots of n = ⌊v/v_max·n_max⌋ internodes heading H' = αH + βT + γE ([`shoots`]);
+//! 7. shedding of branches whose vigor per internode falls below Th ([`vigor`]);
+//! 8. widths by the pipe model, exponents re-solved below width constraints ([`widths`]).
+//!
+//! Space: world metres, Y up, base at the origin. All randomness comes from `Tree::rng`, so the
+//! same species, seed and calls give a byte-identical saved tree.
+
+mod buds;
+mod io;
+mod light;
+mod shoots;
+mod space;
+mod vigor;
+mod widths;
+
+pub use io::{TREE_FORMAT_VERSION, TreeFileError};
+pub use widths::solve_pipe_exponent;
+
+use glam::Vec3;
+use serde::{Deserialize, Serialize};
+
+use crate::environment::{Environment, Scene, SceneMode, ShadowGrid};
+use crate::rng::Rng;
+use crate::species::Species;
+use crate::tree::{Bud, Internode, NodeId, Skeleton, TreeInvariantError};
+
+/// A growing tree: skeleton, species, environment and the generator that drives it.
+#[derive(Clone, Debug, Serialize, Deserialize)]
+pub struct Tree {
+    pub species: Species,
+    /// Growth iterations done so far (0 = the seedling).
+    pub iteration: u32,
+    pub skeleton: Skeleton,
+    pub environment: Environment,
+    /// Selective growth: when set, only buds in the subtree rooted here may grow (all buds still
+    /// consume attraction points in their occupancy spheres).
+    pub growth_mask: Option<NodeId>,
+    pub rng: Rng,
+    /// Pipe-model exponent of each internode's subtree (derived, see [`Tree::update_widths`]).
+    #[serde(skip)]
+    pipe_exponents: Vec<f32>,
+    #[serde(skip)]
+    scratch: Box<Scratch>,
+}
+
+/// How one iteration runs.
+#[derive(Clone, Copy, Default)]
+pub struct StepOptions<'a> {
+    /// Every bud generates attraction points in its perception volume (autonomous growth), and
+    /// shedding runs. Off for brush-guided iterations: only the persistent points feed buds.
+    pub autonomous: bool,
+    pub scene: Option<(&'a dyn Scene, SceneMode)>,
+}
+
+/// What one iteration did.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct IterationStats {
+    pub num_buds: usize,
+    pub num_enabled_buds: usize,
+    pub num_points: usize,
+    pub num_shoots: usize,
+    pub num_new_internodes: usize,
+    pub num_shed_internodes: usize,
+    pub num_pruned_internodes: usize,
+}
+
+/// Summary figures of a tree.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TreeMetrics {
+    pub num_internodes: usize,
+    pub height_m: f32,
+    /// Mean of the crown's extents along X and Z (the horticultural spread).
+    pub crown_width_m: f32,
+    /// Diameter at the base of the trunk.
+    pub trunk_diameter_m: f32,
+    pub age_years: f32,
+}
+
+/// Per-iteration working memory, kept between iterations so the hot loops do not allocate.
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Scratch {
+    pub buds: Vec<buds::BudState>,
+    /// Buds of node i are `buds[node_bud_start[i]..node_bud_start[i + 1]]`, terminal first.
+    pub node_bud_start: Vec<u32>,
+    pub positions: Vec<Vec3>,
+    pub bud_grid: crate::environment::SpatialGrid,
+    pub node_grid: crate::environment::SpatialGrid,
+    pub point_grid: crate::environment::SpatialGrid,
+    pub point_alive: Vec<bool>,
+    pub q_main: Vec<f32>,
+    pub q_lateral: Vec<f32>,
+    pub vigor: Vec<f32>,
+    pub size: Vec<u32>,
+    pub in_mask: Vec<bool>,
+    pub acc: Vec<f64>,
+    pub subtree_root: Vec<u32>,
+}
+
+impl Tree {
+    /// A seedling of `species`: one upright internode with its buds; randomness from `seed`.
+    pub fn new(species: Species, seed: u64) -> Tree {
+        let mut tree = Tree {
+            environment: Environment::default(),
+            skeleton: Skeleton {
+                internodes: Vec::new(),
+            },
+            iteration: 0,
+            growth_mask: None,
+            rng: Rng::new(seed),
+            pipe_exponents: Vec::new(),
+            scratch: Box::default(),
+            species,
+        };
+        tree.environment.shadow = tree.empty_shadow_grid();
+        let l = tree.species.internode_length_m;
+        let mut seedling = Internode {
+            parent: None,
+            main_child: None,
+            lateral_children: Vec::new(),
+            start: Vec3::ZERO,
+            end: Vec3::Y * l,
+            left: Vec3::X,
+            diameter: tree.species.tip_diameter_m,
+            order: 0,
+            born_iteration: 0,
+            terminal_bud: Some(Bud::new(Vec3::Y)),
+            lateral_buds: Vec::new(),
+            width_constraint: None,
+            light_exposure: tree.species.full_exposure,
+        };
+        let azimuth = tree.rng.range_f32(0.0, std::f32::consts::TAU);
+        buds::add_lateral_buds(&tree.species, &mut seedling, azimuth);
+        tree.environment.shadow.apply_node(seedling.end, 1);
+        tree.skeleton.internodes.push(seedling);
+        tree.update_widths();
+        tree
+    }
+
+    fn empty_shadow_grid(&self) -> ShadowGrid {
+        let s = &self.species;
+        ShadowGrid::new(
+            s.internode_length_m * s.shadow_voxel_internodes,
+            s.shadow_strength,
+            s.shadow_decay_base,
+            s.shadow_depth_voxels,
+        )
+    }
+
+    /// Recomputes the shadow grid from the skeleton (after loading or editing positions).
+    pub fn rebuild_shadow(&mut self) {
+        let mut grid = self.empty_shadow_grid();
+        for node in &self.skeleton.internodes {
+            grid.apply_node(node.end, 1);
+        }
+        self.environment.shadow = grid;
+    }
+
+    /// Grows `iterations` autonomous iterations, optionally against a scene.
+    pub fn grow(
+        &mut self,
+        iterations: u32,
+        scene: Option<(&dyn Scene, SceneMode)>,
+    ) -> IterationStats {
+        let mut total = IterationStats::default();
+        for _ in 0..iterations {
+            let s = self.step(StepOptions {
+                autonomous: true,
+                scene,
+            });
+            total.num_buds = s.num_buds;
+            total.num_enabled_buds += s.num_enabled_buds;
+            total.num_points += s.num_points;
+            total.num_shoots += s.num_shoots;
+            total.num_new_internodes += s.num_new_internodes;
+            total.num_shed_internodes += s.num_shed_internodes;
+            total.num_pruned_internodes += s.num_pruned_internodes;
+        }
+        total
+    }
+
+    /// Grows autonomously for `years` more years (rounded to whole iterations).
+    pub fn grow_years(&mut self, years: f32) -> IterationStats {
+        let iterations = self.species.iterations_for_years(years);
+        self.grow(iterations, None)
+    }
+
+    /// Age in years.
+    pub fn age_years(&self) -> f32 {
+        self.iteration as f32 * self.species.years_per_iteration
+    }
+
+    /// One growth iteration (steps 1–8 of the module doc).
+    pub fn step(&mut self, options: StepOptions) -> IterationStats {
+        self.iteration += 1;
+        let mut stats = IterationStats::default();
+        let mut scratch = std::mem::take(&mut self.scratch);
+        buds::collect(self, &mut scratch);
+        light::expose(self, &mut scratch);
+        stats.num_points = space::colonize(self, &mut scratch, options);
+        light::bud_input(self, &mut scratch);
+        let v_max = vigor::distribute(self, &mut scratch);
+        stats.num_buds = scratch.buds.len();
+        stats.num_enabled_buds = scratch.buds.iter().filter(|b| b.enabled).count();
+        let shed = if options.autonomous && v_max > 0.0 {
+            vigor::select_shed(self, &mut scratch, v_max)
+        } else {
+            Vec::new()
+        };
+        let removed = self.skeleton.subtree_flags(&shed);
+        let grown = shoots::grow_all(self, &mut scratch, v_max, &removed, options.scene);
+        stats.num_shoots = grown.0;
+        stats.num_new_internodes = grown.1;
+        if !shed.is_empty() {
+            stats.num_shed_internodes = self.remove_subtrees(&shed);
+        }
+        if let Some((scene, SceneMode::PruneToScene)) = options.scene {
+            stats.num_pruned_internodes = self.prune_to_scene(scene);
+        }
+        space::finish_iteration(self, &scratch);
+        self.scratch = scratch;
+        self.update_light_exposure();
+        self.update_widths();
+        stats
+    }
+
+    /// Removes the subtrees rooted at `roots` (with their shadow), keeping the arena topological.
+    /// The growth mask follows the renumbering (and is cleared if its root is removed).
+    /// Returns how many internodes were removed.
+    pub fn remove_subtrees(&mut self, roots: &[NodeId]) -> usize {
+        let flags = self.skeleton.subtree_flags(roots);
+        let mut count = 0;
+        for (node, &gone) in self.skeleton.internodes.iter().zip(&flags) {
+            if gone {
+                self.environment.shadow.apply_node(node.end, -1);
+                count += 1;
+            }
+        }
+        if count == 0 {
+            return 0;
+        }
+        let remap = self.skeleton.remove_flagged(&flags);
+        self.growth_mask = self
+            .growth_mask
+            .and_then(|m| remap.get(m.index()).copied().flatten());
+        count
+    }
+
+    /// Cuts every internode that entered occupied space, with its subtree. Returns the count.
+    pub fn prune_to_scene(&mut self, scene: &dyn Scene) -> usize {
+        let cut: Vec<NodeId> = (0..self.skeleton.len())
+            .filter(|&i| {
+                let n = &self.skeleton.internodes[i];
+                !scene.is_free(n.start) || !scene.is_segment_free(n.start, n.end)
+            })
+            .map(|i| NodeId(i as u32))
+            .collect();
+        let count = self.remove_subtrees(&cut);
+        if count > 0 {
+            self.update_widths();
+        }
+        count
+    }
+
+    fn update_light_exposure(&mut self) {
+        let s = &self.species;
+        let shadow = &self.environment.shadow;
+        for node in &mut self.skeleton.internodes {
+            node.light_exposure =
+                (s.full_exposure - shadow.shadow_at(node.end) + s.shadow_strength).max(0.0);
+        }
+    }
+
+    /// Ambient light at a point in [0, 1] from the shadow grid: 1 unshaded, 0 in full shade.
+    pub fn ambient_at(&self, point_in_world: Vec3) -> f32 {
+        let s = &self.species;
+        let exposure =
+            s.full_exposure - self.environment.shadow.shadow_at(point_in_world) + s.shadow_strength;
+        (exposure / s.full_exposure).clamp(0.0, 1.0)
+    }
+
+    /// Recomputes every diameter by the pipe model (see [`widths`]); call after edits.
+    pub fn update_widths(&mut self) {
+        let mut scratch = std::mem::take(&mut self.scratch);
+        widths::update(
+            &mut self.skeleton,
+            self.species.tip_diameter_m,
+            self.species.pipe_exponent,
+            &mut self.pipe_exponents,
+            &mut scratch,
+        );
+        self.scratch = scratch;
+    }
+
+    /// Pipe-model exponent n used at internode `id` (d^n = Σ children d_i^n).
+    pub fn pipe_exponent(&self, id: NodeId) -> f32 {
+        self.pipe_exponents
+            .get(id.index())
+            .copied()
+            .unwrap_or(self.species.pipe_exponent)
+    }
+
+    /// Arena invariants plus the growth state's own (finite values, mask in range).
+    pub fn sanity_check(&self) -> Result<(), TreeInvariantError> {
+        self.skeleton.sanity_check()?;
+        if let Some(m) = self.growth_mask
+            && m.index() >= self.skeleton.len()
+        {
+            return Err(TreeInvariantError::Broken {
+                index: m.index(),
+                what: "growth mask points past the arena".into(),
+            });
+        }
+        for (index, node) in self.skeleton.internodes.iter().enumerate() {
+            let buds = node.terminal_bud.iter().chain(&node.lateral_buds);
+            if buds.clone().any(|b| !b.direction.is_finite()) || !node.light_exposure.is_finite() {
+                return Err(TreeInvariantError::Broken {
+                    index,
+                    what: "non-finite bud".into(),
+                });
+            }
+            if node.born_iteration > self.iteration {
+                return Err(TreeInvariantError::Broken {
+                    index,
+                    what: format!(
+                        "born at {} after iteration {}",
+                        node.born_iteration, self.iteration
+                    ),
+                });
+            }
+        }
+        Ok(())
+    }
+
+    /// Height, crown spread, trunk diameter and size.
+    pub fn metrics(&self) -> TreeMetrics {
+        let nodes = &self.skeleton.internodes;
+        let base = nodes.first().map_or(Vec3::ZERO, |n| n.start);
+        let (mut lo, mut hi) = (base, base);
+        for n in nodes {
+            lo = lo.min(n.end);
+            hi = hi.max(n.end);
+        }
+        TreeMetrics {
+            num_internodes: nodes.len(),
+            height_m: hi.y - base.y,
+            crown_width_m: 0.5 * ((hi.x - lo.x) + (hi.z - lo.z)),
+            trunk_diameter_m: nodes.first().map_or(0.0, |n| n.diameter),
+            age_years: self.age_years(),
+        }
+    }
+}
+
+impl PartialEq for Tree {
+    /// Trees are equal when their saved state is (derived caches are ignored).
+    fn eq(&self, other: &Self) -> bool {
+        self.species == other.species
+            && self.iteration == other.iteration
+            && self.skeleton == other.skeleton
+            && self.environment.attraction == other.environment.attraction
+            && self.growth_mask == other.growth_mask
+            && self.rng == other.rng
+    }
+}

@@ -24,5 +24,6 @@ pub mod rng;
 pub mod species;
 pub mod tree;
 
+pub use growth::Tree;
 pub use rng::Rng;
 pub use tree::{Bud, Internode, NodeId, Skeleton};

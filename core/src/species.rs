@@ -1,1 +1,382 @@
-//! (module species: being written)
+//! Species: every parameter of the growth model, as data.
+//!
+//! Presets are JSON files in `core/species/`, embedded in the binary with `include_str!`; users
+//! add their own with [`Species::from_file`]. Units are in field names (`_m`, `_deg`, `_years`,
+//! `_internodes`); each field's doc gives the symbol used by Longay 2014 ch. 4 and
+//! Pałubicki et al. 2009.
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+/// Arrangement of lateral buds along an axis.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Phyllotaxis {
+    /// One bud per node, alternating sides (180°).
+    Distichous,
+    /// One bud per node, each turned by the phyllotactic angle φ.
+    Spiral,
+    /// Two opposite buds per node, pairs turned by 90°.
+    Decussate,
+    /// k buds per node, evenly spaced, whorls turned by φ.
+    Whorled,
+}
+
+/// Control ellipse of gravimorphism (Longay 2014 fig. 4.20), in the plane ⟂ the parent axis.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ControlEllipse {
+    /// s_v: semi-axis along V (the most vertical direction ⟂ H).
+    pub vertical_semi_axis: f32,
+    /// s_p: semi-axis along P (parallel to the ground).
+    pub parallel_semi_axis: f32,
+    /// e_v: offset of the centre along V (> 0 favours upper-side buds).
+    pub vertical_offset: f32,
+}
+
+/// Expected size of the species, from a cited horticultural reference.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct ExpectedSize {
+    pub height_10y_m: f32,
+    pub spread_10y_m: f32,
+    pub height_30y_m: f32,
+    pub spread_30y_m: f32,
+    /// The reference(s) the figures come from, by name.
+    pub source: String,
+}
+
+/// All parameters of one species.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Species {
+    /// Short identifier used on the command line (`birch`).
+    pub name: String,
+    pub common_name: String,
+    pub latin_name: String,
+    /// What the preset should look like.
+    pub description: String,
+    pub expected: ExpectedSize,
+    /// Years represented by one growth iteration (one season = 1).
+    pub years_per_iteration: f32,
+    /// l: length of every internode, metres.
+    pub internode_length_m: f32,
+    /// n_max: internodes in the shoot of the most vigorous bud of an iteration.
+    pub max_shoot_internodes: f32,
+    /// Age at which n_max has halved (n_max·h/(h + age)); 0 keeps n_max constant.
+    pub shoot_length_halving_age_years: f32,
+    /// λ: apical dominance, share of vigor biased to the main axis (0.5 = neutral).
+    pub apical_dominance: f32,
+    /// κ: light sensitivity, Q = b·L^κ (0 = space alone decides).
+    pub light_sensitivity: f32,
+    /// α: weight of the current heading (straightness).
+    pub straightness: f32,
+    /// β: weight of the tropism direction T.
+    pub tropism_weight: f32,
+    /// γ: weight of the environment (optimal growth) direction E.
+    pub environment_weight: f32,
+    /// θ: gravitropic set-point angle from vertical (0 up, 90 horizontal, > 90 downwards).
+    pub gravitropism_angle_deg: f32,
+    /// The main axis (order 0) keeps an upward tropism while laterals use θ (conifers).
+    pub upward_main_axis: bool,
+    /// ψ: angle between a lateral bud and its supporting axis.
+    pub branching_angle_deg: f32,
+    pub phyllotaxis: Phyllotaxis,
+    /// φ: turn between successive nodes (spiral, whorled).
+    pub phyllotactic_angle_deg: f32,
+    /// k: buds per whorl (whorled phyllotaxis only).
+    pub buds_per_whorl: u32,
+    /// Lateral buds only on the last internode of each shoot (rhythmic whorls of conifers).
+    pub lateral_buds_only_at_shoot_end: bool,
+    /// δ: deflection of the supporting axis away from a growing lateral bud.
+    pub deflection_angle_deg: f32,
+    /// r: radius of a bud's occupancy sphere, internode lengths.
+    pub occupancy_radius_internodes: f32,
+    /// d: perception distance beyond r, internode lengths (perception radius r + d).
+    pub perception_distance_internodes: f32,
+    /// ζ: full apex angle of the perception cone.
+    pub perception_angle_deg: f32,
+    /// Autonomous points a fully lit bud generates per iteration (a shaded one generates 1).
+    pub max_points_per_bud: u32,
+    /// Edge of a shadow voxel, internode lengths.
+    pub shadow_voxel_internodes: f32,
+    /// a: shadow a node adds to its own voxel.
+    pub shadow_strength: f32,
+    /// b: decay base of shadow with depth, Δs = a·b^(−q) (b > 1).
+    pub shadow_decay_base: f32,
+    /// q_max: depth of the shadow pyramid, voxels.
+    pub shadow_depth_voxels: u32,
+    /// C: full light exposure.
+    pub full_exposure: f32,
+    /// Gravimorphism control ellipse (s_v, s_p, e_v).
+    pub gravimorphism: ControlEllipse,
+    /// Th: a branch whose vigor per internode (vigor in new internodes, v·n_max/v_max, divided by
+    /// its size) falls below Th is shed; 0 never sheds.
+    pub shedding_threshold: f32,
+    /// d_e: diameter of a tip internode, metres.
+    pub tip_diameter_m: f32,
+    /// n: pipe-model exponent, d^n = Σ d_i^n (re-solved below width constraints).
+    pub pipe_exponent: f32,
+}
+
+/// A species file that cannot be used.
+#[derive(Debug, thiserror::Error)]
+pub enum SpeciesError {
+    #[error("cannot read species file {path}: {source}")]
+    Read {
+        path: String,
+        source: std::io::Error,
+    },
+    #[error("species file {path} is not a valid species: {reason}")]
+    Parse { path: String, reason: String },
+    #[error("species {name} ({path}): {reason}")]
+    Invalid {
+        path: String,
+        name: String,
+        reason: String,
+    },
+    #[error("no species preset named {name:?}; presets: {known}")]
+    UnknownPreset { name: String, known: String },
+}
+
+const PRESET_FILES: [(&str, &str); 6] = [
+    ("birch.json", include_str!("../species/birch.json")),
+    ("oak.json", include_str!("../species/oak.json")),
+    ("maple.json", include_str!("../species/maple.json")),
+    (
+        "norway_spruce.json",
+        include_str!("../species/norway_spruce.json"),
+    ),
+    (
+        "weeping_willow.json",
+        include_str!("../species/weeping_willow.json"),
+    ),
+    (
+        "lombardy_poplar.json",
+        include_str!("../species/lombardy_poplar.json"),
+    ),
+];
+
+impl Species {
+    /// All built-in presets, in a fixed order.
+    pub fn presets() -> Vec<Species> {
+        PRESET_FILES
+            .iter()
+            .filter_map(|(file, text)| Self::from_json_str(text, file).ok())
+            .collect()
+    }
+
+    /// The preset called `name` (case-insensitive; `-` and spaces read as `_`).
+    pub fn by_name(name: &str) -> Result<Species, SpeciesError> {
+        let wanted = name.trim().to_lowercase().replace(['-', ' '], "_");
+        let presets = Self::presets();
+        if let Some(s) = presets.iter().find(|s| s.name == wanted) {
+            return Ok(s.clone());
+        }
+        let known = presets
+            .iter()
+            .map(|s| s.name.as_str())
+            .collect::<Vec<_>>()
+            .join(", ");
+        Err(SpeciesError::UnknownPreset {
+            name: name.to_string(),
+            known,
+        })
+    }
+
+    /// Loads and validates a user species file.
+    pub fn from_file(path: impl AsRef<Path>) -> Result<Species, SpeciesError> {
+        let path = path.as_ref();
+        let shown = path.display().to_string();
+        let text = std::fs::read_to_string(path).map_err(|source| SpeciesError::Read {
+            path: shown.clone(),
+            source,
+        })?;
+        Self::from_json_str(&text, &shown)
+    }
+
+    /// Parses and validates species JSON; `origin` names the source in errors.
+    pub fn from_json_str(text: &str, origin: &str) -> Result<Species, SpeciesError> {
+        let species: Species = serde_json::from_str(text).map_err(|e| SpeciesError::Parse {
+            path: origin.to_string(),
+            reason: e.to_string(),
+        })?;
+        species.validate().map_err(|reason| SpeciesError::Invalid {
+            path: origin.to_string(),
+            name: species.name.clone(),
+            reason,
+        })?;
+        Ok(species)
+    }
+
+    /// Checks ranges; the message names the offending parameter.
+    pub fn validate(&self) -> Result<(), String> {
+        let positive = [
+            ("years_per_iteration", self.years_per_iteration),
+            ("internode_length_m", self.internode_length_m),
+            ("max_shoot_internodes", self.max_shoot_internodes),
+            (
+                "occupancy_radius_internodes",
+                self.occupancy_radius_internodes,
+            ),
+            (
+                "perception_distance_internodes",
+                self.perception_distance_internodes,
+            ),
+            ("shadow_voxel_internodes", self.shadow_voxel_internodes),
+            ("shadow_strength", self.shadow_strength),
+            ("full_exposure", self.full_exposure),
+            ("tip_diameter_m", self.tip_diameter_m),
+            ("pipe_exponent", self.pipe_exponent),
+            (
+                "gravimorphism.vertical_semi_axis",
+                self.gravimorphism.vertical_semi_axis,
+            ),
+            (
+                "gravimorphism.parallel_semi_axis",
+                self.gravimorphism.parallel_semi_axis,
+            ),
+        ];
+        for (name, v) in positive {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(format!("{name} must be a positive number, got {v}"));
+            }
+        }
+        let ranges = [
+            (
+                "shoot_length_halving_age_years",
+                self.shoot_length_halving_age_years,
+                0.0,
+                1e6,
+            ),
+            ("apical_dominance", self.apical_dominance, 0.0, 1.0),
+            ("light_sensitivity", self.light_sensitivity, 0.0, 20.0),
+            ("straightness", self.straightness, 0.0, 1.0),
+            ("tropism_weight", self.tropism_weight, 0.0, 1.0),
+            ("environment_weight", self.environment_weight, 0.0, 1.0),
+            (
+                "gravitropism_angle_deg",
+                self.gravitropism_angle_deg,
+                0.0,
+                180.0,
+            ),
+            ("branching_angle_deg", self.branching_angle_deg, 0.0, 180.0),
+            (
+                "phyllotactic_angle_deg",
+                self.phyllotactic_angle_deg,
+                -360.0,
+                360.0,
+            ),
+            ("deflection_angle_deg", self.deflection_angle_deg, 0.0, 90.0),
+            (
+                "perception_angle_deg",
+                self.perception_angle_deg,
+                1.0,
+                360.0,
+            ),
+            ("shadow_decay_base", self.shadow_decay_base, 1.0001, 1e3),
+            ("shedding_threshold", self.shedding_threshold, 0.0, 1e3),
+            (
+                "gravimorphism.vertical_offset",
+                self.gravimorphism.vertical_offset,
+                -10.0,
+                10.0,
+            ),
+            (
+                "max_shoot_internodes",
+                self.max_shoot_internodes,
+                0.0,
+                200.0,
+            ),
+        ];
+        for (name, v, lo, hi) in ranges {
+            if !(v.is_finite() && (lo..=hi).contains(&v)) {
+                return Err(format!("{name} must lie in [{lo}, {hi}], got {v}"));
+            }
+        }
+        let sum = self.straightness + self.tropism_weight + self.environment_weight;
+        if (sum - 1.0).abs() > 1e-3 {
+            return Err(format!(
+                "straightness α + tropism_weight β + environment_weight γ must be 1, got {sum}"
+            ));
+        }
+        if self.shadow_depth_voxels > 64 {
+            return Err(format!(
+                "shadow_depth_voxels must be at most 64, got {}",
+                self.shadow_depth_voxels
+            ));
+        }
+        if self.phyllotaxis == Phyllotaxis::Whorled && !(1..=12).contains(&self.buds_per_whorl) {
+            return Err(format!(
+                "buds_per_whorl must be 1..=12 for whorled phyllotaxis, got {}",
+                self.buds_per_whorl
+            ));
+        }
+        if !(1..=64).contains(&self.max_points_per_bud) {
+            return Err(format!(
+                "max_points_per_bud must be 1..=64, got {}",
+                self.max_points_per_bud
+            ));
+        }
+        Ok(())
+    }
+
+    /// Lateral buds per node implied by the phyllotaxis.
+    pub fn buds_per_node(&self) -> u32 {
+        match self.phyllotaxis {
+            Phyllotaxis::Distichous | Phyllotaxis::Spiral => 1,
+            Phyllotaxis::Decussate => 2,
+            Phyllotaxis::Whorled => self.buds_per_whorl,
+        }
+    }
+
+    /// Growth iterations covering `years` (rounded to the nearest iteration).
+    pub fn iterations_for_years(&self, years: f32) -> u32 {
+        (years / self.years_per_iteration).round().max(0.0) as u32
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn all_six_presets_load_and_validate() {
+        let names: Vec<String> = Species::presets().into_iter().map(|s| s.name).collect();
+        assert_eq!(
+            names,
+            [
+                "birch",
+                "oak",
+                "maple",
+                "norway_spruce",
+                "weeping_willow",
+                "lombardy_poplar"
+            ]
+        );
+        for (file, text) in PRESET_FILES {
+            if let Err(e) = Species::from_json_str(text, file) {
+                panic!("{e}");
+            }
+        }
+    }
+
+    #[test]
+    fn unknown_preset_and_bad_parameters_are_named_in_errors() {
+        let err = Species::by_name("baobab").unwrap_err().to_string();
+        assert!(err.contains("baobab") && err.contains("birch"), "{err}");
+        let mut birch = Species::by_name("Birch").unwrap();
+        birch.straightness = 0.9;
+        let text = serde_json::to_string(&birch).unwrap();
+        let err = Species::from_json_str(&text, "mine.json")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("mine.json") && err.contains("straightness"),
+            "{err}"
+        );
+        let err = Species::from_json_str("{\"name\": 3}", "x.json")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("x.json"), "{err}");
+    }
+}

@@ -1,6 +1,6 @@
 //! The tree: an arena of internodes (metamers) and their buds.
 //!
-//! Invariants (checked by [`Tree::sanity_check`]):
+//! Invariants (checked by [`Skeleton::sanity_check`]):
 //! - `internodes[0]` is the root (the base of the trunk) whenever the tree is not empty;
 //! - a parent always has a smaller index than its children (the arena is in topological order),
 //!   so a basipetal pass (tips → base) is a reverse loop and an acropetal pass a forward loop;
@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::rng::Rng;
 
-/// Index of an internode in [`Tree::internodes`].
+/// Index of an internode in [`Skeleton::internodes`].
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash, Serialize, Deserialize)]
 pub struct NodeId(pub u32);
 
@@ -31,6 +31,21 @@ pub struct Bud {
     pub direction: Vec3,
     /// False once the bud has produced a shoot or was aborted.
     pub alive: bool,
+    /// Per-bud tropism T that replaces the species' gravitropism for shoots from this bud
+    /// (sketch-based tropism, selective growth). Unit vector.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub tropism_override: Option<Vec3>,
+}
+
+impl Bud {
+    /// A living bud pointing along `direction`.
+    pub fn new(direction: Vec3) -> Self {
+        Bud {
+            direction,
+            alive: true,
+            tropism_override: None,
+        }
+    }
 }
 
 /// One metamer: an internode of fixed length with its buds.
@@ -91,7 +106,7 @@ impl Internode {
     }
 }
 
-/// What [`Tree::sanity_check`] found wrong.
+/// What [`Skeleton::sanity_check`] found wrong.
 #[derive(Clone, Debug, PartialEq, thiserror::Error)]
 pub enum TreeInvariantError {
     #[error("internode {index}: {what}")]
@@ -118,6 +133,77 @@ impl Skeleton {
 
     pub fn is_empty(&self) -> bool {
         self.internodes.is_empty()
+    }
+
+    /// Flags every internode in the subtrees rooted at `roots` (a root and all its descendants).
+    pub fn subtree_flags(&self, roots: &[NodeId]) -> Vec<bool> {
+        let mut flags = vec![false; self.internodes.len()];
+        for r in roots {
+            if let Some(f) = flags.get_mut(r.index()) {
+                *f = true;
+            }
+        }
+        // Parents come before children: one forward pass propagates the flags down.
+        for i in 0..self.internodes.len() {
+            if let Some(p) = self.internodes[i].parent
+                && flags[p.index()]
+            {
+                flags[i] = true;
+            }
+        }
+        flags
+    }
+
+    /// True when `node` lies in the subtree rooted at `root` (O(depth)).
+    pub fn is_in_subtree(&self, node: NodeId, root: NodeId) -> bool {
+        let mut current = Some(node);
+        while let Some(c) = current {
+            if c == root {
+                return true;
+            }
+            if c < root {
+                return false;
+            }
+            current = self.internodes[c.index()].parent;
+        }
+        false
+    }
+
+    /// Removes every flagged internode (flags must be closed under descendants, as
+    /// [`Skeleton::subtree_flags`] makes them), keeping the arena in topological order.
+    /// Parents drop their links to removed children. Returns the new id of each old index
+    /// (`None` for removed ones).
+    pub fn remove_flagged(&mut self, removed: &[bool]) -> Vec<Option<NodeId>> {
+        let mut remap: Vec<Option<NodeId>> = Vec::with_capacity(self.internodes.len());
+        let mut next = 0u32;
+        for (i, &gone) in removed.iter().enumerate().take(self.internodes.len()) {
+            let gone = gone
+                || self.internodes[i]
+                    .parent
+                    .is_some_and(|p| remap[p.index()].is_none());
+            remap.push(if gone {
+                None
+            } else {
+                next += 1;
+                Some(NodeId(next - 1))
+            });
+        }
+        remap.resize(self.internodes.len(), None);
+        let old = std::mem::take(&mut self.internodes);
+        self.internodes.reserve(next as usize);
+        for (i, mut node) in old.into_iter().enumerate() {
+            if remap[i].is_none() {
+                continue;
+            }
+            node.parent = node.parent.and_then(|p| remap[p.index()]);
+            node.main_child = node.main_child.and_then(|c| remap[c.index()]);
+            node.lateral_children.retain(|c| remap[c.index()].is_some());
+            for c in &mut node.lateral_children {
+                *c = remap[c.index()].unwrap_or(*c);
+            }
+            self.internodes.push(node);
+        }
+        remap
     }
 
     /// Checks the arena invariants listed in the module doc.

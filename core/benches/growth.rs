@@ -1,0 +1,81 @@
+//! Growth benchmarks: autonomous growth to 10k, 100k and 300k internodes with the full model
+//! (space colonization, shadow grid, vigor, shedding, widths), and one brush-guided iteration on
+//! a 20k-internode tree. Targets (one core): 100k internodes ≤ 0.5 s, linear scaling,
+//! brush iteration ≤ 4 ms.
+
+use std::hint::black_box;
+
+use criterion::{BatchSize, Criterion, Throughput, criterion_group, criterion_main};
+use glam::Vec3;
+use sylva_core::Tree;
+use sylva_core::growth::StepOptions;
+use sylva_core::rng::Rng;
+use sylva_core::species::Species;
+
+const SEED: u64 = 7;
+
+/// Oak with short internodes and no age slow-down, so 300k internodes fit in a bounded crown.
+fn bench_species() -> Species {
+    let mut s = Species::by_name("oak").expect("oak preset");
+    s.internode_length_m = 0.05;
+    s.shoot_length_halving_age_years = 0.0;
+    s
+}
+
+/// Grows autonomously until the tree has at least `target` internodes.
+fn grow_to(target: usize) -> Tree {
+    let mut tree = Tree::new(bench_species(), SEED);
+    while tree.skeleton.len() < target && tree.iteration < 400 {
+        tree.step(StepOptions {
+            autonomous: true,
+            scene: None,
+        });
+    }
+    tree
+}
+
+fn autonomous_growth(c: &mut Criterion) {
+    let mut group = c.benchmark_group("autonomous_growth");
+    group.sample_size(10);
+    for target in [10_000usize, 100_000, 300_000] {
+        group.throughput(Throughput::Elements(target as u64));
+        group.bench_function(format!("{}k_internodes", target / 1000), |b| {
+            b.iter(|| black_box(grow_to(target)).skeleton.len())
+        });
+    }
+    group.finish();
+}
+
+fn brush_iteration(c: &mut Criterion) {
+    let tree = grow_to(20_000);
+    let top = tree.metrics().height_m;
+    let mut rng = Rng::new(11);
+    // A brush dab: 300 points in a 0.4 m sphere just outside the crown top.
+    let centre = Vec3::new(0.0, top + 0.2, 0.0);
+    let points: Vec<Vec3> = (0..300)
+        .map(|_| centre + rng.in_unit_ball() * 0.4)
+        .collect();
+    let mut group = c.benchmark_group("brush_iteration");
+    group.bench_function("20k_internodes", |b| {
+        b.iter_batched(
+            || {
+                let mut t = tree.clone();
+                for p in &points {
+                    t.environment.attraction.add_persistent(*p);
+                }
+                t
+            },
+            |mut t| {
+                black_box(t.step(StepOptions {
+                    autonomous: false,
+                    scene: None,
+                }))
+            },
+            BatchSize::LargeInput,
+        )
+    });
+    group.finish();
+}
+
+criterion_group!(benches, autonomous_growth, brush_iteration);
+criterion_main!(benches);

@@ -1,0 +1,134 @@
+//! Buds: gathering the living buds of the tree for an iteration, and placing new lateral buds by
+//! phyllotaxis (distichous, spiral with angle φ, decussate, whorled with k buds) at branching
+//! angle ψ from the heading, in the internode's HLU frame.
+
+use glam::Vec3;
+
+use super::{Scratch, Tree};
+use crate::species::{Phyllotaxis, Species};
+use crate::tree::Internode;
+
+/// Slot of a terminal bud in [`BudState::slot`]; lateral buds use their index.
+pub(crate) const TERMINAL: u32 = u32::MAX;
+
+/// Working state of one living bud during an iteration.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct BudState {
+    pub node: u32,
+    pub slot: u32,
+    pub position: Vec3,
+    pub direction: Vec3,
+    /// L: light exposure.
+    pub light: f32,
+    /// Q: bud input.
+    pub q: f32,
+    /// v: vigor reaching the bud.
+    pub vigor: f32,
+    /// Σ unit vectors to the attraction points this bud won.
+    pub environment_sum: Vec3,
+    /// Σ tropism directions carried by those points.
+    pub tropism_sum: Vec3,
+    pub num_points: u32,
+    pub enabled: bool,
+    /// In the selective-growth mask (or no mask set).
+    pub may_grow: bool,
+}
+
+/// Fills `scratch.buds` with every living bud, node by node (terminal first), and the mask.
+pub(crate) fn collect(tree: &Tree, scratch: &mut Scratch) {
+    let nodes = &tree.skeleton.internodes;
+    scratch.buds.clear();
+    scratch.node_bud_start.clear();
+    scratch.in_mask.clear();
+    scratch
+        .in_mask
+        .resize(nodes.len(), tree.growth_mask.is_none());
+    if let Some(mask) = tree.growth_mask
+        && mask.index() < nodes.len()
+    {
+        scratch.in_mask[mask.index()] = true;
+        for (i, node) in nodes.iter().enumerate().skip(mask.index() + 1) {
+            if let Some(p) = node.parent {
+                scratch.in_mask[i] = scratch.in_mask[p.index()];
+            }
+        }
+    }
+    for (i, node) in nodes.iter().enumerate() {
+        scratch.node_bud_start.push(scratch.buds.len() as u32);
+        let may_grow = scratch.in_mask[i];
+        let mut push = |slot: u32, direction: Vec3| {
+            scratch.buds.push(BudState {
+                node: i as u32,
+                slot,
+                position: node.end,
+                direction,
+                light: 0.0,
+                q: 0.0,
+                vigor: 0.0,
+                environment_sum: Vec3::ZERO,
+                tropism_sum: Vec3::ZERO,
+                num_points: 0,
+                enabled: false,
+                may_grow,
+            });
+        };
+        if let Some(bud) = &node.terminal_bud
+            && bud.alive
+        {
+            push(TERMINAL, bud.direction);
+        }
+        for (slot, bud) in node.lateral_buds.iter().enumerate() {
+            if bud.alive {
+                push(slot as u32, bud.direction);
+            }
+        }
+    }
+    scratch.node_bud_start.push(scratch.buds.len() as u32);
+}
+
+/// Azimuth turn between successive nodes of an axis.
+fn azimuth_step(species: &Species) -> f32 {
+    match species.phyllotaxis {
+        Phyllotaxis::Distichous => std::f32::consts::PI,
+        Phyllotaxis::Decussate => std::f32::consts::FRAC_PI_2,
+        Phyllotaxis::Spiral | Phyllotaxis::Whorled => species.phyllotactic_angle_deg.to_radians(),
+    }
+}
+
+/// Azimuth of the first lateral bud of `node` in its HLU frame, if it has one.
+pub(crate) fn first_bud_azimuth(node: &Internode) -> Option<f32> {
+    let bud = node.lateral_buds.first()?;
+    let (h, l) = (node.heading(), node.left);
+    let u = h.cross(l);
+    Some(bud.direction.dot(u).atan2(bud.direction.dot(l)))
+}
+
+/// Azimuth for the next node of an axis whose previous node had `previous` (random if none).
+pub(crate) fn next_azimuth(species: &Species, previous: Option<f32>, random: f32) -> f32 {
+    previous.map_or(random, |a| a + azimuth_step(species))
+}
+
+/// Adds the lateral buds of a new internode, the first at `azimuth` around its heading.
+pub(crate) fn add_lateral_buds(species: &Species, node: &mut Internode, azimuth: f32) {
+    let h = node.heading();
+    let l = node.left;
+    let u = h.cross(l);
+    let (sin_psi, cos_psi) = species.branching_angle_deg.to_radians().sin_cos();
+    let k = species.buds_per_node();
+    node.lateral_buds.clear();
+    for j in 0..k {
+        let az = azimuth + j as f32 * std::f32::consts::TAU / k as f32;
+        let (s, c) = az.sin_cos();
+        let dir = (cos_psi * h + sin_psi * (c * l + s * u))
+            .try_normalize()
+            .unwrap_or(h);
+        node.lateral_buds.push(crate::tree::Bud::new(dir));
+    }
+}
+
+/// Parallel transport of the L axis onto a new heading: the minimal change keeping L ⟂ H.
+pub(crate) fn transport_left(left: Vec3, heading: Vec3) -> Vec3 {
+    (left - left.dot(heading) * heading)
+        .try_normalize()
+        .unwrap_or_else(|| heading.any_orthonormal_vector())
+}

@@ -1,0 +1,172 @@
+//! Step 2: competition for space (space colonization).
+//!
+//! Every bud has an occupancy sphere of radius r and a perception cone of apex angle ζ and radius
+//! r + d (internode lengths). Attraction points inside any occupancy sphere are removed; each
+//! remaining point feeds the closest bud whose perception volume holds it; a bud with at least one
+//! point is enabled and its optimal direction E is the normalised mean of the unit vectors
+//! towards its points. In autonomous growth every bud first generates points in its own
+//! perception volume (1 when shaded, up to `max_points_per_bud` in full light).
+//!
+//! All queries go through uniform grids ([`crate::environment::SpatialGrid`]): the cost is
+//! O(points × buds nearby), never O(points × buds).
+
+use glam::Vec3;
+
+use super::{Scratch, StepOptions, Tree};
+use crate::environment::{AttractionPoints, SceneMode};
+use crate::rng::Rng;
+
+/// Radii of the model in metres: (occupancy r, perception r + d, cos(ζ/2)).
+pub(crate) fn radii(tree: &Tree) -> (f32, f32, f32) {
+    let s = &tree.species;
+    let l = s.internode_length_m;
+    let r = s.occupancy_radius_internodes * l;
+    let perception = (s.occupancy_radius_internodes + s.perception_distance_internodes) * l;
+    let cos_half = (0.5 * s.perception_angle_deg.to_radians()).cos();
+    (r, perception, cos_half)
+}
+
+/// Runs step 2; returns the number of attraction points that survived occupancy.
+pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOptions) -> usize {
+    let (r, perception, cos_half) = radii(tree);
+    if options.autonomous {
+        generate_points(tree, scratch, r, perception, cos_half);
+    }
+    if let Some((scene, SceneMode::GrowInFront)) = options.scene {
+        tree.environment
+            .attraction
+            .points
+            .retain(|p| scene.is_free(p.position));
+    }
+    let points = &tree.environment.attraction.points;
+    // Occupancy: every node (internode end) holds buds or did; its sphere takes points away.
+    scratch.positions.clear();
+    scratch
+        .positions
+        .extend(tree.skeleton.internodes.iter().map(|n| n.end));
+    scratch.node_grid.rebuild(&scratch.positions, r);
+    scratch.point_alive.clear();
+    scratch.point_alive.extend(
+        points
+            .iter()
+            .map(|p| !scratch.node_grid.any_within(p.position, r)),
+    );
+    // Perception: each surviving point feeds its closest perceiving bud.
+    scratch.positions.clear();
+    scratch
+        .positions
+        .extend(scratch.buds.iter().map(|b| b.position));
+    scratch.bud_grid.rebuild(&scratch.positions, perception);
+    let mut alive_count = 0;
+    for (point, &alive) in points.iter().zip(&scratch.point_alive) {
+        if !alive {
+            continue;
+        }
+        alive_count += 1;
+        let mut best: Option<(u32, f32)> = None;
+        let buds = &scratch.buds;
+        scratch
+            .bud_grid
+            .for_each_within(point.position, perception, |bi, bud_pos, d2| {
+                let bud = &buds[bi as usize];
+                if !bud.may_grow || best.is_some_and(|(_, bd)| bd <= d2) {
+                    return;
+                }
+                if (point.position - bud_pos).dot(bud.direction) >= cos_half * d2.sqrt() {
+                    best = Some((bi, d2));
+                }
+            });
+        if let Some((bi, d2)) = best {
+            let bud = &mut scratch.buds[bi as usize];
+            bud.environment_sum += (point.position - bud.position) / d2.sqrt().max(1e-12);
+            bud.num_points += 1;
+            if let Some(t) = point.tropism {
+                bud.tropism_sum += t;
+            }
+        }
+    }
+    for bud in &mut scratch.buds {
+        bud.enabled = bud.may_grow && bud.num_points > 0;
+    }
+    scratch.positions.clear();
+    scratch.positions.extend(points.iter().map(|p| p.position));
+    scratch.point_grid.rebuild(&scratch.positions, perception);
+    alive_count
+}
+
+/// Autonomous points: each bud adds 1 + round((max − 1)·L/C) points in its perception shell.
+fn generate_points(tree: &mut Tree, scratch: &Scratch, r: f32, perception: f32, cos_half: f32) {
+    let s = &tree.species;
+    let extra = (s.max_points_per_bud - 1) as f32;
+    let (r3, p3) = (r * r * r, perception * perception * perception);
+    let points: &mut AttractionPoints = &mut tree.environment.attraction;
+    let rng: &mut Rng = &mut tree.rng;
+    points.points.reserve(scratch.buds.len() * 2);
+    for bud in &scratch.buds {
+        let count = 1 + (extra * (bud.light / s.full_exposure).clamp(0.0, 1.0)).round() as u32;
+        let (b1, b2) = bud.direction.any_orthonormal_pair();
+        for _ in 0..count {
+            // Uniform in the cone: cos of the polar angle uniform in [cos(ζ/2), 1]; radius
+            // uniform in the volume of the shell r..r + d.
+            let cos_polar = 1.0 - rng.next_f32() * (1.0 - cos_half);
+            let sin_polar = (1.0 - cos_polar * cos_polar).max(0.0).sqrt();
+            let (sa, ca) = rng.range_f32(0.0, std::f32::consts::TAU).sin_cos();
+            let dir = cos_polar * bud.direction + sin_polar * (ca * b1 + sa * b2);
+            let radius = (r3 + rng.next_f32() * (p3 - r3)).cbrt();
+            points.add_transient(bud.position + dir * radius);
+        }
+    }
+}
+
+/// Optimal direction E (and carried tropism) for a shoot tip re-perceiving the remaining points.
+pub(crate) fn perceive(
+    tree: &Tree,
+    scratch: &Scratch,
+    tip: Vec3,
+    heading: Vec3,
+) -> Option<(Vec3, Option<Vec3>)> {
+    let (_, perception, cos_half) = radii(tree);
+    let points = &tree.environment.attraction.points;
+    let mut sum = Vec3::ZERO;
+    let mut tropism = Vec3::ZERO;
+    let mut count = 0;
+    scratch
+        .point_grid
+        .for_each_within(tip, perception, |pi, p, d2| {
+            if !scratch.point_alive[pi as usize] || d2 <= 0.0 {
+                return;
+            }
+            let d = d2.sqrt();
+            if (p - tip).dot(heading) >= cos_half * d {
+                sum += (p - tip) / d;
+                count += 1;
+                if let Some(t) = points[pi as usize].tropism {
+                    tropism += t;
+                }
+            }
+        });
+    (count > 0).then(|| {
+        (
+            sum.try_normalize().unwrap_or(heading),
+            tropism.try_normalize(),
+        )
+    })
+}
+
+/// Marks the points within the occupancy sphere of a new node as consumed.
+pub(crate) fn consume(scratch: &mut Scratch, node_end: Vec3, r: f32) {
+    let alive = &mut scratch.point_alive;
+    scratch
+        .point_grid
+        .for_each_within(node_end, r, |pi, _, _| alive[pi as usize] = false);
+}
+
+/// End of an iteration: transient points are cleared, consumed persistent points removed.
+pub(crate) fn finish_iteration(tree: &mut Tree, scratch: &Scratch) {
+    let mut index = 0;
+    tree.environment.attraction.points.retain(|p| {
+        let keep = p.persistent && scratch.point_alive.get(index).copied().unwrap_or(true);
+        index += 1;
+        keep
+    });
+}

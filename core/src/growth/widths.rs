@@ -1,0 +1,169 @@
+//! Step 8: widths by the pipe model, d^n = Σ d_i^n from the tips (diameter d_e) down.
+//!
+//! Width constraints split the tree into subtrees: the root's subtree and one below every
+//! constrained internode. A subtree whose root is constrained to D, with boundary leaves of
+//! diameters d_j (its tips, d_e, and the constrained internodes below it), gets its own exponent
+//! from Σ (d_j/D)^n = 1, solved by Newton–Raphson; for M tips only this is
+//! n = log M / (log D − log d_e). An unconstrained root uses the species exponent.
+
+use super::Scratch;
+use crate::tree::Skeleton;
+
+/// Exponent bounds: outside them a constraint cannot be met by the pipe model.
+const MIN_EXPONENT: f64 = 0.25;
+const MAX_EXPONENT: f64 = 64.0;
+
+/// Solves Σ_j count_j·(d_j/D)^n = 1 for n by safeguarded Newton–Raphson (bisection fallback).
+/// Returns `None` when no n in [0.25, 64] satisfies it (e.g. a single leaf thinner than D).
+pub fn solve_pipe_exponent(leaves: &[(f64, f64)], base_diameter: f64, initial: f64) -> Option<f64> {
+    let f = |n: f64| -> (f64, f64) {
+        let mut value = -1.0;
+        let mut slope = 0.0;
+        for &(count, d) in leaves {
+            let ratio = d / base_diameter;
+            let term = count * ratio.powf(n);
+            value += term;
+            slope += term * ratio.ln();
+        }
+        (value, slope)
+    };
+    let (mut lo, mut hi) = (MIN_EXPONENT, MAX_EXPONENT);
+    let (f_lo, f_hi) = (f(lo).0, f(hi).0);
+    if f_lo.signum() == f_hi.signum() {
+        return None;
+    }
+    let decreasing = f_lo > 0.0;
+    let mut n = initial.clamp(lo, hi);
+    for _ in 0..100 {
+        let (value, slope) = f(n);
+        if value.abs() < 1e-12 {
+            return Some(n);
+        }
+        if (value > 0.0) == decreasing {
+            lo = n;
+        } else {
+            hi = n;
+        }
+        let newton = n - value / slope;
+        n = if slope != 0.0 && newton > lo && newton < hi {
+            newton
+        } else {
+            0.5 * (lo + hi)
+        };
+        if hi - lo < 1e-12 {
+            break;
+        }
+    }
+    Some(n)
+}
+
+/// Recomputes all diameters and the per-internode exponents.
+pub(crate) fn update(
+    skeleton: &mut Skeleton,
+    tip_diameter: f32,
+    default_exponent: f32,
+    exponents: &mut Vec<f32>,
+    scratch: &mut Scratch,
+) {
+    let nodes = &mut skeleton.internodes;
+    let n = nodes.len();
+    let roots = &mut scratch.subtree_root;
+    roots.clear();
+    roots.resize(n, 0);
+    let mut any_constraint = false;
+    for i in 0..n {
+        let constrained = nodes[i].width_constraint.is_some();
+        any_constraint |= constrained;
+        roots[i] = match nodes[i].parent {
+            Some(p) if !constrained => roots[p.index()],
+            _ => i as u32,
+        };
+    }
+    exponents.clear();
+    exponents.resize(n, default_exponent);
+    if any_constraint {
+        solve_subtree_exponents(nodes, roots, tip_diameter, default_exponent, exponents);
+    }
+    // Basipetal: acc[i] = Σ over children of d_c^{n_i}; d_i = acc^{1/n_i}.
+    let acc = &mut scratch.acc;
+    acc.clear();
+    acc.resize(n, 0.0);
+    for i in (0..n).rev() {
+        let exponent = f64::from(exponents[i]);
+        let node = &mut nodes[i];
+        let (diameter, mass) = if let Some(d) = node.width_constraint {
+            (d, f64::from(d).powf(exponent))
+        } else if node.is_tip() {
+            (tip_diameter, f64::from(tip_diameter).powf(exponent))
+        } else {
+            ((acc[i].powf(1.0 / exponent)) as f32, acc[i])
+        };
+        node.diameter = diameter;
+        if let Some(p) = node.parent {
+            let p = p.index();
+            acc[p] += if roots[i] == roots[p] {
+                mass
+            } else {
+                f64::from(diameter).powf(f64::from(exponents[p]))
+            };
+        }
+    }
+}
+
+fn solve_subtree_exponents(
+    nodes: &[crate::tree::Internode],
+    roots: &[u32],
+    tip_diameter: f32,
+    default_exponent: f32,
+    exponents: &mut [f32],
+) {
+    // Boundary leaves per subtree root: (root, count, diameter).
+    let mut leaves: Vec<(u32, f64, f64)> = Vec::new();
+    for (i, node) in nodes.iter().enumerate() {
+        if let (Some(d), Some(p)) = (node.width_constraint, node.parent) {
+            leaves.push((roots[p.index()], 1.0, f64::from(d)));
+        } else if node.width_constraint.is_none() && node.is_tip() {
+            leaves.push((roots[i], 1.0, f64::from(tip_diameter)));
+        }
+    }
+    leaves.sort_by(|a, b| a.0.cmp(&b.0).then(a.2.total_cmp(&b.2)));
+    // Merge equal diameters so M identical tips cost one term.
+    let mut merged: Vec<(u32, f64, f64)> = Vec::new();
+    for leaf in leaves {
+        match merged.last_mut() {
+            Some(last) if last.0 == leaf.0 && last.2 == leaf.2 => last.1 += leaf.1,
+            _ => merged.push(leaf),
+        }
+    }
+    let mut start = 0;
+    while start < merged.len() {
+        let root = merged[start].0;
+        let end = start + merged[start..].iter().take_while(|l| l.0 == root).count();
+        if let Some(d) = nodes[root as usize].width_constraint {
+            let terms: Vec<(f64, f64)> = merged[start..end].iter().map(|l| (l.1, l.2)).collect();
+            if let Some(n) = solve_pipe_exponent(&terms, f64::from(d), f64::from(default_exponent))
+            {
+                exponents[root as usize] = n as f32;
+            }
+        }
+        start = end;
+    }
+    for i in 0..nodes.len() {
+        exponents[i] = exponents[roots[i] as usize];
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn newton_recovers_the_closed_form_exponent_for_identical_tips() {
+        // M tips of d_e under a base of D: n = log M / (log D − log d_e).
+        let (m, d_e, d_b) = (1000.0f64, 0.005, 0.3);
+        let n = solve_pipe_exponent(&[(m, d_e)], d_b, 2.0).unwrap();
+        let closed = m.ln() / (d_b.ln() - d_e.ln());
+        assert!((n - closed).abs() < 1e-9, "{n} vs {closed}");
+        assert!(solve_pipe_exponent(&[(1.0, 0.01)], 0.3, 2.0).is_none());
+    }
+}
