@@ -11,3 +11,34 @@
 //! **Features.** `opencv` (default on desktop): feature tracking, PnP and video readers through
 //! OpenCV; OpenCV types never leave the `cv` module. Without it, the plane, scale, map and depth
 //! mesh still build (mobile targets).
+
+pub mod ba;
+pub mod camera;
+pub mod features;
+pub mod frame;
+pub mod ground_plane;
+pub mod linalg;
+pub mod map;
+pub mod metrics;
+pub mod pose;
+pub mod scale;
+pub mod sequence;
+pub mod world;
+
+#[cfg(feature = "opencv")]
+pub mod cv;
+#[cfg(feature = "opencv")]
+mod initializer;
+#[cfg(feature = "opencv")]
+mod mapping;
+#[cfg(feature = "opencv")]
+pub mod tracker;
+#[cfg(feature = "opencv")]
+pub mod report;
+
+pub use camera::{Camera, CameraError};
+pub use frame::{Frame, FrameOutput, GrayImage, Plane, TrackedPoint, TrackingState};
+pub use sequence::{FrameSource, SequenceError, SourceEvent, TumSequence};
+#[cfg(feature = "opencv")]
+pub use tracker::{Tracker, TrackerConfig, TrackerError};
+

@@ -1,0 +1,82 @@
+//! Quick runner: `cargo run --release -p sylva-tracking --example track_tum -- SEQUENCE`.
+fn main() {
+    let Some(root) = std::env::args().nth(1) else {
+        eprintln!("usage: track_tum SEQUENCE");
+        std::process::exit(2);
+    };
+    sylva_tracking::cv::configure_single_thread();
+    let mut config = sylva_tracking::TrackerConfig::default();
+    // Tuning aid: SYLVA_CFG="min_parallax_deg=0.5,outlier_px=4".
+    for pair in std::env::var("SYLVA_CFG")
+        .unwrap_or_default()
+        .split(',')
+        .filter(|p| !p.is_empty())
+    {
+        let (key, value) = pair.split_once('=').expect("key=value");
+        let v: f64 = value.parse().expect("number");
+        match key {
+            "max_tracks" => config.max_tracks = v as usize,
+            "min_corner_distance_px" => config.min_corner_distance_px = v as f32,
+            "max_fb_error_px" => config.max_fb_error_px = v as f32,
+            "outlier_px" => config.outlier_px = v,
+            "huber_px" => config.huber_px = v,
+            "min_parallax_deg" => config.min_parallax_deg = v,
+            "init_min_parallax_deg" => config.init_min_parallax_deg = v,
+            "local_window" => config.local_window = v as usize,
+            "max_local_search" => config.max_local_search = v as usize,
+            "max_keyframe_gap" => config.max_keyframe_gap = v as usize,
+            other => panic!("unknown key {other}"),
+        }
+    }
+    match sylva_tracking::report::run_sequence(
+        std::path::Path::new(&root),
+        config,
+        |_, _| {},
+        |s| eprintln!("warning: skipped frame {}: {}", s.path.display(), s.reason),
+    ) {
+        Ok(report) => {
+            eprintln!(
+                "keyframes={} points={}",
+                report.num_keyframes, report.num_map_points
+            );
+            if std::env::var_os("SYLVA_TRACE").is_some() {
+                for row in &report.trajectory {
+                    eprintln!("{} {:?} {}", row.index, row.state, row.num_points);
+                }
+            }
+            if std::env::var_os("SYLVA_ROT").is_some() {
+                rotation_check(&root, &report);
+            }
+            println!("{}", report.summary_line());
+        }
+        Err(e) => {
+            eprintln!("error: {e}");
+            std::process::exit(1);
+        }
+    }
+}
+
+/// Diagnostic: orientation error relative to the first tracked frame, against ground truth.
+fn rotation_check(root: &str, report: &sylva_tracking::report::TrackReport) {
+    let seq = sylva_tracking::TumSequence::open(std::path::Path::new(root)).expect("sequence");
+    let mut first: Option<(glam::DQuat, glam::DQuat)> = None;
+    for row in &report.trajectory {
+        let Some(q) = row.orientation else { continue };
+        let Some(gt) = seq.groundtruth_at(row.timestamp_s, 0.02) else {
+            continue;
+        };
+        let est = glam::DQuat::from_array(q);
+        let truth = glam::DQuat::from_mat3(&gt.matrix3);
+        let (e0, t0) = *first.get_or_insert((est, truth));
+        let rel_est = e0.inverse() * est;
+        let rel_truth = t0.inverse() * truth;
+        if row.index % 20 == 0 {
+            eprintln!(
+                "rot {} err {:.2} deg (truth moved {:.1} deg)",
+                row.index,
+                rel_est.angle_between(rel_truth).to_degrees(),
+                rel_truth.angle_between(glam::DQuat::IDENTITY).to_degrees()
+            );
+        }
+    }
+}

@@ -1,0 +1,519 @@
+//! Everything that touches OpenCV. Types here speak glam and this crate's structs; `Mat` and
+//! `Vector` never leave the module.
+
+use crate::camera::Camera;
+use crate::frame::{Frame, GrayImage};
+use crate::pose::Se3;
+use crate::sequence::{FrameSource, SequenceError, SourceEvent};
+use glam::{DMat3, DQuat, DVec2, DVec3, Vec2};
+use opencv::core::{self, KeyPoint, Mat, Point2f, Point3f, Size, TermCriteria, Vector};
+use opencv::prelude::*;
+use opencv::{calib3d, features2d, imgproc, video, videoio};
+
+/// An OpenCV call failed.
+#[derive(Debug, thiserror::Error)]
+#[error("OpenCV: {0}")]
+pub struct CvError(String);
+
+impl From<opencv::Error> for CvError {
+    fn from(e: opencv::Error) -> Self {
+        CvError(e.to_string())
+    }
+}
+
+type Result<T> = std::result::Result<T, CvError>;
+
+/// Lucas–Kanade window (pixels) and pyramid levels.
+pub const LK_WINDOW: i32 = 21;
+pub const LK_LEVELS: i32 = 3;
+
+/// Runs OpenCV on one thread (benchmarks, and to leave cores to the app) and quiets its logs.
+pub fn configure_single_thread() {
+    // Both calls only fail on invalid arguments; failure to configure is harmless.
+    let _ = core::set_num_threads(1);
+    let _ = core::set_log_level(core::LogLevel::LOG_LEVEL_ERROR);
+}
+
+fn mat_from_gray(image: &GrayImage) -> Result<Mat> {
+    let borrowed =
+        Mat::new_rows_cols_with_data(image.height as i32, image.width as i32, &image.pixels)?;
+    Ok(borrowed.try_clone()?)
+}
+
+/// An image pyramid for Lucas–Kanade, built once per frame and reused by every track call.
+pub struct Pyramid {
+    levels: Vector<Mat>,
+}
+
+impl Pyramid {
+    pub fn build(image: &GrayImage) -> Result<Self> {
+        let mat = mat_from_gray(image)?;
+        let mut levels = Vector::<Mat>::new();
+        video::build_optical_flow_pyramid(
+            &mat,
+            &mut levels,
+            Size::new(LK_WINDOW, LK_WINDOW),
+            LK_LEVELS,
+            true,
+            core::BORDER_REFLECT_101,
+            core::BORDER_CONSTANT,
+            true,
+        )?;
+        Ok(Self { levels })
+    }
+}
+
+fn to_points(points: &[Vec2]) -> Vector<Point2f> {
+    points.iter().map(|p| Point2f::new(p.x, p.y)).collect()
+}
+
+fn lk(
+    prev: &Pyramid,
+    next: &Pyramid,
+    from: &[Vec2],
+    guess: Option<&[Vec2]>,
+) -> Result<Vec<Option<Vec2>>> {
+    if from.is_empty() {
+        return Ok(Vec::new());
+    }
+    let prev_pts = to_points(from);
+    let mut next_pts = to_points(guess.unwrap_or(from));
+    let mut status = Vector::<u8>::new();
+    let mut err = Vector::<f32>::new();
+    let flags = if guess.is_some() {
+        video::OPTFLOW_USE_INITIAL_FLOW
+    } else {
+        0
+    };
+    video::calc_optical_flow_pyr_lk(
+        &prev.levels,
+        &next.levels,
+        &prev_pts,
+        &mut next_pts,
+        &mut status,
+        &mut err,
+        Size::new(LK_WINDOW, LK_WINDOW),
+        LK_LEVELS,
+        TermCriteria::new(core::TermCriteria_COUNT + core::TermCriteria_EPS, 20, 0.03)?,
+        flags,
+        1e-4,
+    )?;
+    Ok(next_pts
+        .iter()
+        .zip(status.iter())
+        .map(|(p, ok)| (ok != 0).then_some(Vec2::new(p.x, p.y)))
+        .collect())
+}
+
+/// Pyramidal Lucas–Kanade from `prev` to `next` with a forward-backward check: a track survives
+/// when tracking it back lands within `max_fb_error_px` of where it started. `guess` seeds the
+/// forward search (e.g. projections of map points).
+pub fn track_points(
+    prev: &Pyramid,
+    next: &Pyramid,
+    from: &[Vec2],
+    guess: Option<&[Vec2]>,
+    max_fb_error_px: f32,
+) -> Result<Vec<Option<Vec2>>> {
+    if from.is_empty() {
+        return Ok(Vec::new());
+    }
+    let forward = lk(prev, next, from, guess)?;
+    let alive: Vec<usize> = (0..from.len()).filter(|&i| forward[i].is_some()).collect();
+    let there: Vec<Vec2> = alive.iter().filter_map(|&i| forward[i]).collect();
+    let back_guess: Vec<Vec2> = alive.iter().map(|&i| from[i]).collect();
+    let backward = lk(next, prev, &there, Some(&back_guess))?;
+    let mut result = vec![None; from.len()];
+    for (k, &i) in alive.iter().enumerate() {
+        if let Some(b) = backward[k]
+            && b.distance(from[i]) <= max_fb_error_px
+        {
+            result[i] = forward[i];
+        }
+    }
+    Ok(result)
+}
+
+/// Shi–Tomasi corners at least `min_distance_px` away from each other and from `existing`.
+pub fn detect_corners(
+    image: &GrayImage,
+    max_corners: usize,
+    min_distance_px: f32,
+    existing: &[Vec2],
+) -> Result<Vec<Vec2>> {
+    if max_corners == 0 {
+        return Ok(Vec::new());
+    }
+    let mat = mat_from_gray(image)?;
+    let mut mask = Mat::new_rows_cols_with_default(
+        image.height as i32,
+        image.width as i32,
+        core::CV_8UC1,
+        core::Scalar::all(255.0),
+    )?;
+    for p in existing {
+        imgproc::circle(
+            &mut mask,
+            core::Point::new(p.x.round() as i32, p.y.round() as i32),
+            min_distance_px.round() as i32,
+            core::Scalar::all(0.0),
+            -1,
+            imgproc::LINE_8,
+            0,
+        )?;
+    }
+    let mut corners = Vector::<Point2f>::new();
+    imgproc::good_features_to_track(
+        &mat,
+        &mut corners,
+        max_corners as i32,
+        0.01,
+        min_distance_px as f64,
+        &mask,
+        3,
+        false,
+        0.04,
+    )?;
+    Ok(corners.iter().map(|p| Vec2::new(p.x, p.y)).collect())
+}
+
+fn ideal_pixels(camera: &Camera, normalized: &[DVec2]) -> Vector<Point2f> {
+    normalized
+        .iter()
+        .map(|n| {
+            Point2f::new(
+                (camera.fx * n.x + camera.cx) as f32,
+                (camera.fy * n.y + camera.cy) as f32,
+            )
+        })
+        .collect()
+}
+
+fn camera_matrix(camera: &Camera) -> Result<Mat> {
+    let k = [
+        [camera.fx, 0.0, camera.cx],
+        [0.0, camera.fy, camera.cy],
+        [0.0, 0.0, 1.0],
+    ];
+    Ok(Mat::from_slice_2d(&k)?)
+}
+
+fn mat3_from(m: &Mat) -> Result<DMat3> {
+    let mut cols = [DVec3::ZERO; 3];
+    for (c, col) in cols.iter_mut().enumerate() {
+        for r in 0..3 {
+            col[r] = *m.at_2d::<f64>(r as i32, c as i32)?;
+        }
+    }
+    Ok(DMat3::from_cols(cols[0], cols[1], cols[2]))
+}
+
+/// Relative pose from an essential matrix (RANSAC) and cheirality: `second_from_first` with a
+/// unit translation, plus the inlier mask. Inputs are normalised undistorted coordinates.
+pub fn relative_pose(
+    camera: &Camera,
+    first: &[DVec2],
+    second: &[DVec2],
+    threshold_px: f64,
+) -> Result<Option<(Se3, Vec<bool>)>> {
+    if first.len() < 8 {
+        return Ok(None);
+    }
+    let (p1, p2) = (ideal_pixels(camera, first), ideal_pixels(camera, second));
+    let k = camera_matrix(camera)?;
+    let mut mask = Mat::default();
+    let e = calib3d::find_essential_mat(
+        &p1,
+        &p2,
+        &k,
+        calib3d::RANSAC,
+        0.999,
+        threshold_px,
+        1000,
+        &mut mask,
+    )?;
+    if e.rows() != 3 || e.cols() != 3 {
+        return Ok(None);
+    }
+    let (mut r, mut t) = (Mat::default(), Mat::default());
+    calib3d::recover_pose_estimated(&e, &p1, &p2, &k, &mut r, &mut t, &mut mask)?;
+    let rotation = DQuat::from_mat3(&mat3_from(&r)?).normalize();
+    let translation = DVec3::new(*t.at::<f64>(0)?, *t.at::<f64>(1)?, *t.at::<f64>(2)?);
+    let inliers = (0..first.len() as i32)
+        .map(|i| mask.at::<u8>(i).map(|&m| m != 0))
+        .collect::<std::result::Result<Vec<bool>, _>>()?;
+    Ok(Some((Se3::new(rotation, translation), inliers)))
+}
+
+/// Number of homography inliers (RANSAC) between two views, for model selection.
+pub fn homography_inliers(
+    camera: &Camera,
+    first: &[DVec2],
+    second: &[DVec2],
+    threshold_px: f64,
+) -> Result<usize> {
+    if first.len() < 4 {
+        return Ok(0);
+    }
+    let (p1, p2) = (ideal_pixels(camera, first), ideal_pixels(camera, second));
+    let mut mask = Mat::default();
+    calib3d::find_homography(&p1, &p2, &mut mask, calib3d::RANSAC, threshold_px)?;
+    Ok(mask
+        .data_bytes()
+        .map(|b| b.iter().filter(|&&m| m != 0).count())
+        .unwrap_or(0))
+}
+
+/// Camera pose from 2D–3D correspondences by EPnP inside RANSAC: `camera_from_world` and the
+/// inlier indices. Image points are normalised undistorted coordinates.
+pub fn pnp_ransac(
+    camera: &Camera,
+    world: &[DVec3],
+    normalized: &[DVec2],
+    guess: Option<Se3>,
+    threshold_px: f32,
+) -> Result<Option<(Se3, Vec<usize>)>> {
+    if world.len() < 6 {
+        return Ok(None);
+    }
+    let object: Vector<Point3f> = world
+        .iter()
+        .map(|p| Point3f::new(p.x as f32, p.y as f32, p.z as f32))
+        .collect();
+    let image = ideal_pixels(camera, normalized);
+    let k = camera_matrix(camera)?;
+    let (mut rvec, mut tvec) = (Mat::default(), Mat::default());
+    if let Some(g) = guess {
+        let aa = g.rotation.to_scaled_axis();
+        rvec = Mat::from_slice_2d(&[[aa.x], [aa.y], [aa.z]])?;
+        tvec = Mat::from_slice_2d(&[[g.translation.x], [g.translation.y], [g.translation.z]])?;
+    }
+    let mut inliers = Vector::<i32>::new();
+    let found = calib3d::solve_pnp_ransac(
+        &object,
+        &image,
+        &k,
+        &core::no_array(),
+        &mut rvec,
+        &mut tvec,
+        guess.is_some(),
+        100,
+        threshold_px,
+        0.99,
+        &mut inliers,
+        calib3d::SOLVEPNP_EPNP,
+    )?;
+    if !found || inliers.len() < 6 {
+        return Ok(None);
+    }
+    let get = |m: &Mat, i: i32| -> Result<f64> { Ok(*m.at::<f64>(i)?) };
+    let aa = DVec3::new(get(&rvec, 0)?, get(&rvec, 1)?, get(&rvec, 2)?);
+    let t = DVec3::new(get(&tvec, 0)?, get(&tvec, 1)?, get(&tvec, 2)?);
+    let pose = Se3::new(crate::pose::exp_so3(aa), t);
+    Ok(Some((pose, inliers.iter().map(|i| i as usize).collect())))
+}
+
+/// ORB keypoints and descriptors (for relocalisation).
+pub struct OrbFeatures {
+    orb: core::Ptr<features2d::ORB>,
+}
+
+/// A 256-bit ORB descriptor.
+pub type Descriptor = [u8; 32];
+
+impl OrbFeatures {
+    pub fn new(max_features: usize) -> Result<Self> {
+        let orb = features2d::ORB::create(
+            max_features as i32,
+            1.2,
+            8,
+            31,
+            0,
+            2,
+            features2d::ORB_ScoreType::HARRIS_SCORE,
+            31,
+            20,
+        )?;
+        Ok(Self { orb })
+    }
+
+    fn run(
+        &mut self,
+        image: &GrayImage,
+        keypoints: &mut Vector<KeyPoint>,
+        provided: bool,
+    ) -> Result<Vec<Descriptor>> {
+        let mat = mat_from_gray(image)?;
+        let mut descriptors = Mat::default();
+        self.orb.detect_and_compute(
+            &mat,
+            &core::no_array(),
+            keypoints,
+            &mut descriptors,
+            provided,
+        )?;
+        let mut out = Vec::with_capacity(keypoints.len());
+        for row in 0..descriptors.rows() {
+            let mut d = [0u8; 32];
+            for (c, byte) in d.iter_mut().enumerate() {
+                *byte = *descriptors.at_2d::<u8>(row, c as i32)?;
+            }
+            out.push(d);
+        }
+        Ok(out)
+    }
+
+    /// Detects keypoints and describes them.
+    pub fn detect(&mut self, image: &GrayImage) -> Result<Vec<(Vec2, Descriptor)>> {
+        let mut keypoints = Vector::<KeyPoint>::new();
+        let descriptors = self.run(image, &mut keypoints, false)?;
+        Ok(keypoints
+            .iter()
+            .map(|k| Vec2::new(k.pt().x, k.pt().y))
+            .zip(descriptors)
+            .collect())
+    }
+
+    /// Describes given points; points ORB drops (too near the border) come back as None.
+    pub fn describe(
+        &mut self,
+        image: &GrayImage,
+        points: &[Vec2],
+    ) -> Result<Vec<Option<Descriptor>>> {
+        let mut keypoints: Vector<KeyPoint> = Vector::new();
+        for (i, p) in points.iter().enumerate() {
+            keypoints.push(KeyPoint::new_coords(
+                p.x, p.y, 31.0, -1.0, 0.0, 0, i as i32,
+            )?);
+        }
+        let descriptors = self.run(image, &mut keypoints, true)?;
+        let mut out = vec![None; points.len()];
+        for (k, d) in keypoints.iter().zip(descriptors) {
+            if let Some(slot) = out.get_mut(k.class_id() as usize) {
+                *slot = Some(d);
+            }
+        }
+        Ok(out)
+    }
+}
+
+/// Hamming distance between two ORB descriptors.
+pub fn hamming(a: &Descriptor, b: &Descriptor) -> u32 {
+    a.iter().zip(b).map(|(x, y)| (x ^ y).count_ones()).sum()
+}
+
+/// Frames from a video file, an image-sequence pattern or a live camera (OpenCV videoio).
+pub struct VideoSource {
+    capture: videoio::VideoCapture,
+    camera: Camera,
+    what: String,
+    index: usize,
+    frame_rate_hz: f64,
+}
+
+impl VideoSource {
+    /// Opens a video file (or a `printf`-style image pattern).
+    pub fn open_file(
+        path: &std::path::Path,
+        camera: Camera,
+    ) -> std::result::Result<Self, SequenceError> {
+        let what = path.display().to_string();
+        let capture =
+            videoio::VideoCapture::from_file_def(path).map_err(|e| SequenceError::Video {
+                what: what.clone(),
+                problem: e.to_string(),
+            })?;
+        Self::wrap(capture, camera, what)
+    }
+
+    /// Opens a live camera by index.
+    pub fn open_camera(index: i32, camera: Camera) -> std::result::Result<Self, SequenceError> {
+        let what = format!("camera {index}");
+        let capture = videoio::VideoCapture::new_def(index).map_err(|e| SequenceError::Video {
+            what: what.clone(),
+            problem: e.to_string(),
+        })?;
+        Self::wrap(capture, camera, what)
+    }
+
+    fn wrap(
+        capture: videoio::VideoCapture,
+        camera: Camera,
+        what: String,
+    ) -> std::result::Result<Self, SequenceError> {
+        if !capture.is_opened().unwrap_or(false) {
+            return Err(SequenceError::Video {
+                what,
+                problem: "cannot be opened".into(),
+            });
+        }
+        let fps = capture.get(videoio::CAP_PROP_FPS).unwrap_or(0.0);
+        let frame_rate_hz = if fps > 0.0 {
+            fps
+        } else {
+            camera.frame_rate_hz.unwrap_or(30.0)
+        };
+        Ok(Self {
+            capture,
+            camera,
+            what,
+            index: 0,
+            frame_rate_hz,
+        })
+    }
+}
+
+impl FrameSource for VideoSource {
+    fn camera(&self) -> &Camera {
+        &self.camera
+    }
+
+    fn next_event(&mut self) -> Option<SourceEvent> {
+        let mut bgr = Mat::default();
+        let index = self.index;
+        self.index += 1;
+        match self.capture.read(&mut bgr) {
+            Ok(true) if !bgr.empty() => {}
+            Ok(_) => return None,
+            Err(e) => {
+                return Some(SourceEvent::Skipped {
+                    index,
+                    path: self.what.clone().into(),
+                    reason: e.to_string(),
+                });
+            }
+        }
+        let converted = gray_from_mat(&bgr, &self.camera);
+        Some(match converted {
+            Ok(image) => SourceEvent::Frame(Frame {
+                index,
+                timestamp_s: index as f64 / self.frame_rate_hz,
+                image,
+            }),
+            Err(reason) => SourceEvent::Skipped {
+                index,
+                path: self.what.clone().into(),
+                reason,
+            },
+        })
+    }
+}
+
+fn gray_from_mat(mat: &Mat, camera: &Camera) -> std::result::Result<GrayImage, String> {
+    let mut gray = Mat::default();
+    if mat.channels() == 3 {
+        imgproc::cvt_color_def(mat, &mut gray, imgproc::COLOR_BGR2GRAY)
+            .map_err(|e| e.to_string())?;
+    } else {
+        gray = mat.try_clone().map_err(|e| e.to_string())?;
+    }
+    let (w, h) = (gray.cols() as u32, gray.rows() as u32);
+    if w != camera.width || h != camera.height {
+        return Err(format!(
+            "frame is {w} x {h}, the camera says {} x {}",
+            camera.width, camera.height
+        ));
+    }
+    let bytes = gray.data_bytes().map_err(|e| e.to_string())?.to_vec();
+    GrayImage::from_pixels(w, h, bytes).ok_or_else(|| "bad frame buffer".into())
+}

@@ -1,0 +1,260 @@
+//! Runs the tracker over a whole TUM sequence and measures it: per-stage timings, tracked
+//! fraction and, with ground truth, the trajectory errors of [`crate::metrics`].
+
+use crate::frame::{FrameOutput, TrackingState};
+use crate::metrics::{PosePair, TrajectoryErrors, trajectory_errors};
+use crate::sequence::{FrameSource, SequenceError, SourceEvent, TumSequence, decode_depth_m};
+use crate::tracker::{Tracker, TrackerConfig, TrackerError};
+use glam::DAffine3;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// Largest time gap when pairing a frame with its ground-truth pose (TUM's associate.py: 20 ms).
+pub const MAX_GROUNDTRUTH_GAP_S: f64 = 0.02;
+/// Anchor depth when the first frame has no depth map, metres.
+pub const DEFAULT_ANCHOR_DEPTH_M: f64 = 2.0;
+
+/// Something the run could not do.
+#[derive(Debug, thiserror::Error)]
+pub enum RunError {
+    #[error(transparent)]
+    Sequence(#[from] SequenceError),
+    #[error(transparent)]
+    Tracker(#[from] TrackerError),
+}
+
+/// A frame the source could not read.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct SkippedFrame {
+    pub index: usize,
+    pub path: PathBuf,
+    pub reason: String,
+}
+
+/// Milliseconds spent per stage over the run.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct StageTimings {
+    pub decode_ms: Vec<f64>,
+    pub track_ms: Vec<f64>,
+}
+
+/// Everything measured on one run.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct TrackReport {
+    pub sequence: PathBuf,
+    pub frames: usize,
+    pub tracked_frames: usize,
+    pub tracked_fraction: f64,
+    pub errors: Option<TrajectoryErrors>,
+    pub median_decode_ms: f64,
+    /// Median tracking time per frame, decode excluded.
+    pub ms_per_frame: f64,
+    pub num_keyframes: usize,
+    pub num_map_points: usize,
+    pub skipped: Vec<SkippedFrame>,
+    pub scale_source: Option<crate::scale::ScaleSource>,
+    /// Per frame: index, timestamp, state, `world_from_camera` translation (if tracked).
+    pub trajectory: Vec<TrajectoryRow>,
+    /// True positions of the tracked frames, aligned estimated positions (for plots).
+    #[serde(skip)]
+    pub aligned: Vec<([f64; 3], [f64; 3])>,
+}
+
+/// One frame of the trajectory.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct TrajectoryRow {
+    pub index: usize,
+    pub timestamp_s: f64,
+    pub state: TrackingState,
+    pub position: Option<[f64; 3]>,
+    /// `world_from_camera` rotation as a quaternion (x, y, z, w), if tracked.
+    pub orientation: Option<[f64; 4]>,
+    /// Map points tracked in the frame.
+    pub num_points: usize,
+}
+
+/// Tracks every frame of a TUM sequence. `progress` is called after each frame with (done,
+/// total); `on_skip` with each unreadable frame.
+pub fn run_sequence(
+    root: &Path,
+    config: TrackerConfig,
+    mut progress: impl FnMut(usize, usize),
+    mut on_skip: impl FnMut(&SkippedFrame),
+) -> Result<TrackReport, RunError> {
+    let sequence = TumSequence::open(root)?;
+    let mut source = sequence.source();
+    let total = source.len_hint().unwrap_or(0);
+    let mut tracker = Tracker::new(sequence.camera, config)?;
+    let mut outputs: Vec<FrameOutput> = Vec::new();
+    let mut timings = StageTimings::default();
+    let mut skipped = Vec::new();
+    let mut done = 0;
+    loop {
+        let start = Instant::now();
+        let Some(event) = source.next_event() else {
+            break;
+        };
+        timings.decode_ms.push(start.elapsed().as_secs_f64() * 1e3);
+        done += 1;
+        match event {
+            SourceEvent::Frame(frame) => {
+                let up = sequence.up_in_camera_at(frame.timestamp_s);
+                let start = Instant::now();
+                let output = tracker.track(&frame, up.map(|u| u * 9.81))?;
+                timings.track_ms.push(start.elapsed().as_secs_f64() * 1e3);
+                outputs.push(output);
+                for late in tracker.take_late_poses() {
+                    if let Some(o) = outputs.iter_mut().find(|o| o.index == late.index) {
+                        o.world_from_camera = Some(late.world_from_camera);
+                        o.state = TrackingState::Ok;
+                    }
+                }
+            }
+            SourceEvent::Skipped {
+                index,
+                path,
+                reason,
+            } => {
+                let skip = SkippedFrame {
+                    index,
+                    path,
+                    reason,
+                };
+                on_skip(&skip);
+                skipped.push(skip);
+            }
+        }
+        progress(done, total);
+    }
+    Ok(summarise(&sequence, &tracker, outputs, timings, skipped))
+}
+
+fn median(mut v: Vec<f64>) -> f64 {
+    if v.is_empty() {
+        return f64::NAN;
+    }
+    v.sort_by(f64::total_cmp);
+    v[v.len() / 2]
+}
+
+fn summarise(
+    sequence: &TumSequence,
+    tracker: &Tracker,
+    outputs: Vec<FrameOutput>,
+    timings: StageTimings,
+    skipped: Vec<SkippedFrame>,
+) -> TrackReport {
+    let frames = sequence.frames.len();
+    let tracked: Vec<&FrameOutput> = outputs
+        .iter()
+        .filter(|o| o.world_from_camera.is_some())
+        .collect();
+    let pairs: Vec<PosePair> = tracked
+        .iter()
+        .filter_map(|o| {
+            Some(PosePair {
+                index: o.index,
+                estimated: o.world_from_camera?,
+                truth: sequence.groundtruth_at(o.timestamp_s, MAX_GROUNDTRUTH_GAP_S)?,
+            })
+        })
+        .collect();
+    let first_truth = sequence
+        .frames
+        .first()
+        .and_then(|f| sequence.groundtruth_at(f.timestamp_s, MAX_GROUNDTRUTH_GAP_S));
+    let errors = first_truth.and_then(|first| {
+        trajectory_errors(
+            &pairs,
+            &sequence.camera,
+            &first,
+            first_anchor_depth_m(sequence),
+        )
+    });
+    let aligned = match &errors {
+        Some(e) => pairs
+            .iter()
+            .map(|p| {
+                let est = e.alignment.transform_point(p.estimated.translation);
+                (p.truth.translation.to_array(), est.to_array())
+            })
+            .collect(),
+        None => Vec::new(),
+    };
+    let trajectory = outputs
+        .iter()
+        .map(|o| TrajectoryRow {
+            index: o.index,
+            timestamp_s: o.timestamp_s,
+            state: o.state,
+            position: o
+                .world_from_camera
+                .map(|a: DAffine3| a.translation.to_array()),
+            orientation: o
+                .world_from_camera
+                .map(|a| glam::DQuat::from_mat3(&a.matrix3).normalize().to_array()),
+            num_points: o.tracked_points.len(),
+        })
+        .collect();
+    TrackReport {
+        sequence: sequence.root.clone(),
+        frames,
+        tracked_frames: tracked.len(),
+        tracked_fraction: tracked.len() as f64 / frames.max(1) as f64,
+        errors,
+        median_decode_ms: median(timings.decode_ms.clone()),
+        ms_per_frame: median(timings.track_ms.clone()),
+        num_keyframes: tracker.map().keyframes.len(),
+        num_map_points: tracker.map().points.len(),
+        skipped,
+        scale_source: tracker.world().map(|w| w.scale_source),
+        trajectory,
+        aligned,
+    }
+}
+
+/// Median valid depth of the first frame's depth map (the anchors' depth).
+fn first_anchor_depth_m(sequence: &TumSequence) -> f64 {
+    let (Some(first), Some(scale)) = (sequence.frames.first(), sequence.camera.depth_scale) else {
+        return DEFAULT_ANCHOR_DEPTH_M;
+    };
+    let Some(depth) = sequence
+        .depth
+        .iter()
+        .find(|d| (d.timestamp_s - first.timestamp_s).abs() < 0.05)
+    else {
+        return DEFAULT_ANCHOR_DEPTH_M;
+    };
+    match decode_depth_m(&depth.path, scale) {
+        Ok((_, _, metres)) => {
+            let valid: Vec<f64> = metres
+                .iter()
+                .filter(|&&d| d > 0.0)
+                .map(|&d| d as f64)
+                .collect();
+            if valid.is_empty() {
+                DEFAULT_ANCHOR_DEPTH_M
+            } else {
+                median(valid)
+            }
+        }
+        Err(_) => DEFAULT_ANCHOR_DEPTH_M,
+    }
+}
+
+impl TrackReport {
+    /// The closing `key=value` line (error fields only with ground truth).
+    pub fn summary_line(&self) -> String {
+        let mut line = format!(
+            "frames={} tracked_fraction={:.3}",
+            self.frames, self.tracked_fraction
+        );
+        if let Some(e) = &self.errors {
+            line += &format!(
+                " ate_rmse_m={:.4} window_ate_m={:.4} scale_spread={:.3} rot_err_deg={:.3} anchor_px={:.2}",
+                e.ate_rmse_m, e.window_ate_m, e.scale_spread, e.rot_err_deg, e.anchor_px
+            );
+        }
+        line + &format!(" ms_per_frame={:.2}", self.ms_per_frame)
+    }
+}

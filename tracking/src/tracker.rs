@@ -1,0 +1,453 @@
+//! The monocular tracker (the ORB-SLAM split: frame → tracker → map): Lucas–Kanade tracks, two-
+//! view initialisation, per-frame pose from the map (motion-only refinement, PnP-RANSAC as a
+//! fallback), the local map searched in every frame, keyframes with local bundle adjustment, and
+//! relocalisation by ORB descriptors + PnP.
+
+use crate::ba::{BaConfig, refine_pose, reprojection_error_px};
+use crate::camera::Camera;
+use crate::cv::{self, CvError, OrbFeatures, Pyramid};
+use crate::features::{Track, normalized};
+use crate::frame::{Frame, FrameOutput, Plane, TrackedPoint, TrackingState};
+use crate::initializer::Initializer;
+use crate::map::Map;
+use crate::pose::Se3;
+use crate::world::WorldFrame;
+use glam::{DAffine3, DVec2, DVec3, Vec2};
+use std::collections::{HashMap, HashSet};
+
+/// Tracking failed in a way that is not about the footage (an OpenCV error).
+#[derive(Debug, thiserror::Error)]
+pub enum TrackerError {
+    #[error(transparent)]
+    Cv(#[from] CvError),
+}
+
+/// Tracker settings; defaults suit 640 × 480 handheld footage at 30 Hz.
+#[derive(Clone, Copy, Debug)]
+pub struct TrackerConfig {
+    /// Corners kept alive at once. Default 300.
+    pub max_tracks: usize,
+    /// Minimum distance between corners, pixels. Default 14.
+    pub min_corner_distance_px: f32,
+    /// Forward-backward Lucas–Kanade tolerance, pixels. Default 1.0.
+    pub max_fb_error_px: f32,
+    /// Reprojection error beyond which a track is an outlier, pixels. Default 3.0.
+    pub outlier_px: f64,
+    /// Huber threshold δ for pose refinement and bundle adjustment, pixels. Default 1.5.
+    pub huber_px: f64,
+    /// Smallest ray angle for triangulating a point, degrees. Default 1.0.
+    pub min_parallax_deg: f64,
+    /// Median ray angle needed to initialise, degrees. Default 1.0.
+    pub init_min_parallax_deg: f64,
+    /// Triangulated points needed to initialise. Default 80.
+    pub init_min_points: usize,
+    /// Fewest inlier map points for a pose. Default 12.
+    pub min_pose_inliers: usize,
+    /// Keyframes optimised by local bundle adjustment. Default 8.
+    pub local_window: usize,
+    /// Map points searched by reprojection per frame at most. Default 150.
+    pub max_local_search: usize,
+    /// A keyframe at least every this many frames. Default 8.
+    pub max_keyframe_gap: usize,
+    /// Frames after a failure before `RecentlyLost` becomes `Lost`. Default 30.
+    pub lost_after_frames: usize,
+    /// Holding height for the metric scale, metres. Default 1.5.
+    pub holding_height_m: f64,
+}
+
+impl Default for TrackerConfig {
+    fn default() -> Self {
+        Self {
+            max_tracks: 300,
+            min_corner_distance_px: 14.0,
+            max_fb_error_px: 1.0,
+            outlier_px: 3.0,
+            huber_px: 1.5,
+            min_parallax_deg: 1.0,
+            init_min_parallax_deg: 1.0,
+            init_min_points: 80,
+            min_pose_inliers: 12,
+            local_window: 8,
+            max_local_search: 150,
+            max_keyframe_gap: 8,
+            lost_after_frames: 30,
+            holding_height_m: crate::scale::DEFAULT_HOLDING_HEIGHT_M,
+        }
+    }
+}
+
+/// A pose found late: frames seen while initialising get theirs once the first map exists.
+#[derive(Clone, Copy, Debug)]
+pub struct LatePose {
+    pub index: usize,
+    pub world_from_camera: DAffine3,
+}
+
+/// The monocular tracker.
+pub struct Tracker {
+    pub(crate) camera: Camera,
+    pub(crate) config: TrackerConfig,
+    pub(crate) state: TrackingState,
+    pub(crate) map: Map,
+    pub(crate) tracks: Vec<Track>,
+    pub(crate) prev_pyramid: Option<Pyramid>,
+    /// `camera_from_world` (map frame) of the previous frame, and the motion since the one before.
+    pub(crate) prev_pose: Option<Se3>,
+    pub(crate) velocity: Se3,
+    pub(crate) keyframe_pyramids: HashMap<usize, Pyramid>,
+    pub(crate) init: Option<Initializer>,
+    pub(crate) frames_since_keyframe: usize,
+    pub(crate) tracked_at_keyframe: usize,
+    pub(crate) frames_failed: usize,
+    pub(crate) world: Option<WorldFrame>,
+    pub(crate) gravity_up: Option<DVec3>,
+    pub(crate) late_poses: Vec<LatePose>,
+    pub(crate) orb: OrbFeatures,
+}
+
+impl Tracker {
+    pub fn new(camera: Camera, config: TrackerConfig) -> Result<Self, TrackerError> {
+        Ok(Self {
+            camera,
+            config,
+            state: TrackingState::NotInitialized,
+            map: Map::default(),
+            tracks: Vec::new(),
+            prev_pyramid: None,
+            prev_pose: None,
+            velocity: Se3::IDENTITY,
+            keyframe_pyramids: HashMap::new(),
+            init: None,
+            frames_since_keyframe: 0,
+            tracked_at_keyframe: 0,
+            frames_failed: 0,
+            world: None,
+            gravity_up: None,
+            late_poses: Vec::new(),
+            orb: OrbFeatures::new(1000)?,
+        })
+    }
+
+    pub fn state(&self) -> TrackingState {
+        self.state
+    }
+
+    pub fn map(&self) -> &Map {
+        &self.map
+    }
+
+    /// The world frame (ground plane, scale) once the map exists.
+    pub fn world(&self) -> Option<&WorldFrame> {
+        self.world.as_ref()
+    }
+
+    /// Poses of earlier frames found since the last call (frames seen while initialising).
+    pub fn take_late_poses(&mut self) -> Vec<LatePose> {
+        std::mem::take(&mut self.late_poses)
+    }
+
+    /// Tracks one frame. `accelerometer` is the specific force in camera axes (X right, Y down,
+    /// Z forward), m/s², when the footage has one: at rest it points up.
+    pub fn track(
+        &mut self,
+        frame: &Frame,
+        accelerometer: Option<DVec3>,
+    ) -> Result<FrameOutput, TrackerError> {
+        if let Some(a) = accelerometer.filter(|a| a.length() > 1.0) {
+            self.gravity_up = Some(a.normalize());
+        }
+        let blank = frame.image.contrast() < 4.0;
+        let pyramid = Pyramid::build(&frame.image)?;
+        let pose = match self.state {
+            TrackingState::NotInitialized | TrackingState::Initializing if blank => None,
+            TrackingState::NotInitialized => {
+                self.start_initializing(frame, pyramid)?;
+                return Ok(self.output(frame, None));
+            }
+            TrackingState::Initializing => {
+                let pose = self.continue_initializing(frame, pyramid)?;
+                return Ok(self.output(frame, pose));
+            }
+            _ if blank => None,
+            _ => self.track_with_map(frame, &pyramid)?,
+        };
+        match pose {
+            Some(pose) => {
+                self.frames_failed = 0;
+                self.state = TrackingState::Ok;
+                if let Some(prev) = self.prev_pose {
+                    self.velocity = pose.compose(&prev.inverse());
+                }
+                self.prev_pose = Some(pose);
+                self.prev_pyramid = Some(pyramid);
+                self.frames_since_keyframe += 1;
+                if self.needs_keyframe() {
+                    self.insert_keyframe(frame, pose)?;
+                }
+                let pose = self.prev_pose.unwrap_or(pose);
+                Ok(self.output(frame, Some(pose)))
+            }
+            None => {
+                self.frames_failed += 1;
+                self.velocity = Se3::IDENTITY;
+                self.tracks.clear();
+                self.prev_pyramid = None;
+                self.state = if self.frames_failed > self.config.lost_after_frames {
+                    TrackingState::Lost
+                } else {
+                    TrackingState::RecentlyLost
+                };
+                Ok(self.output(frame, None))
+            }
+        }
+    }
+
+    /// Pose of a tracked frame: LK from the previous frame, else relocalisation.
+    fn track_with_map(
+        &mut self,
+        frame: &Frame,
+        pyramid: &Pyramid,
+    ) -> Result<Option<Se3>, TrackerError> {
+        let (Some(prev_pyramid), Some(prev_pose)) = (self.prev_pyramid.as_ref(), self.prev_pose)
+        else {
+            return self.relocalise(frame);
+        };
+        let predicted = self.velocity.compose(&prev_pose);
+        let guesses: Vec<Vec2> = self
+            .tracks
+            .iter()
+            .map(|t| self.predict_pixel(t, &prev_pose, &predicted))
+            .collect();
+        let from: Vec<Vec2> = self.tracks.iter().map(|t| t.pixel).collect();
+        let moved = cv::track_points(
+            prev_pyramid,
+            pyramid,
+            &from,
+            Some(&guesses),
+            self.config.max_fb_error_px,
+        )?;
+        let mut kept = Vec::with_capacity(self.tracks.len());
+        for (track, next) in self.tracks.iter().zip(moved) {
+            if let Some(pixel) = next.filter(|p| self.camera.contains(p.as_dvec2(), 2.0)) {
+                kept.push(Track { pixel, ..*track });
+            }
+        }
+        let before = (
+            self.tracks.iter().filter(|t| t.point.is_some()).count(),
+            self.tracks.len(),
+        );
+        self.tracks = kept;
+        let after_lk = self.tracks.iter().filter(|t| t.point.is_some()).count();
+        let estimated = self.estimate_pose(predicted)?;
+        if std::env::var_os("SYLVA_TRACE").is_some() {
+            let after_pose = self.tracks.iter().filter(|t| t.point.is_some()).count();
+            eprintln!(
+                "frame {}: points {} tracks {} -> lk {} -> pose {}",
+                frame.index, before.0, before.1, after_lk, after_pose
+            );
+        }
+        let Some(pose) = estimated else {
+            return self.relocalise(frame);
+        };
+        self.search_local_map(pyramid, &pose)?;
+        Ok(self.estimate_pose(pose)?.or(Some(pose)))
+    }
+
+    /// Where a track should appear under the predicted pose (rotation only for candidates).
+    fn predict_pixel(&self, track: &Track, prev: &Se3, predicted: &Se3) -> Vec2 {
+        let in_prev_camera = match track.point.and_then(|id| self.map.points.get(&id)) {
+            Some(point) => {
+                return self
+                    .project(predicted, point.position)
+                    .unwrap_or(track.pixel);
+            }
+            None => normalized(&self.camera, track.pixel).extend(1.0),
+        };
+        let rotation = predicted.rotation * prev.rotation.inverse();
+        let rotated = rotation * in_prev_camera;
+        self.camera
+            .pixel_from_camera(rotated)
+            .filter(|p| self.camera.contains(*p, 0.0))
+            .map(|p| p.as_vec2())
+            .unwrap_or(track.pixel)
+    }
+
+    pub(crate) fn project(&self, camera_from_world: &Se3, point: DVec3) -> Option<Vec2> {
+        self.camera
+            .pixel_from_camera(camera_from_world.transform_point(point))
+            .filter(|p| self.camera.contains(*p, 4.0))
+            .map(|p| p.as_vec2())
+    }
+
+    pub(crate) fn ba_config(&self, iterations: usize) -> BaConfig {
+        BaConfig {
+            focal: self.camera.focal(),
+            huber_px: self.config.huber_px,
+            max_iterations: iterations,
+        }
+    }
+
+    /// Pose from the tracks that see map points: robust refinement from `start`, PnP-RANSAC
+    /// when that leaves too few inliers. Outlier tracks lose their point.
+    fn estimate_pose(&mut self, start: Se3) -> Result<Option<Se3>, TrackerError> {
+        let pairs: Vec<(usize, DVec3, DVec2)> = self
+            .tracks
+            .iter()
+            .enumerate()
+            .filter_map(|(i, t)| {
+                let p = self.map.points.get(&t.point?)?;
+                Some((i, p.position, normalized(&self.camera, t.pixel)))
+            })
+            .collect();
+        if pairs.len() < self.config.min_pose_inliers {
+            return Ok(None);
+        }
+        let world: Vec<DVec3> = pairs.iter().map(|p| p.1).collect();
+        let image: Vec<DVec2> = pairs.iter().map(|p| p.2).collect();
+        let mut wide = self.ba_config(10);
+        wide.huber_px = 8.0;
+        let mut pose = refine_pose(start, &world, &image, &wide);
+        pose = refine_pose(pose, &world, &image, &self.ba_config(10));
+        let focal = self.camera.focal();
+        let count = |pose: &Se3| {
+            pairs
+                .iter()
+                .filter(|p| reprojection_error_px(pose, p.1, p.2, focal) <= self.config.outlier_px)
+                .count()
+        };
+        if count(&pose) * 2 < pairs.len() {
+            match cv::pnp_ransac(
+                &self.camera,
+                &world,
+                &image,
+                Some(start),
+                self.config.outlier_px as f32,
+            )? {
+                Some((found, _)) => pose = refine_pose(found, &world, &image, &self.ba_config(10)),
+                None => return Ok(None),
+            }
+        }
+        let inliers: Vec<usize> = (0..pairs.len())
+            .filter(|&k| {
+                reprojection_error_px(&pose, pairs[k].1, pairs[k].2, focal)
+                    <= self.config.outlier_px
+            })
+            .collect();
+        if inliers.len() < self.config.min_pose_inliers {
+            return Ok(None);
+        }
+        let (w, n): (Vec<DVec3>, Vec<DVec2>) =
+            inliers.iter().map(|&k| (pairs[k].1, pairs[k].2)).unzip();
+        pose = refine_pose(pose, &w, &n, &self.ba_config(10));
+        let inlier_tracks: HashSet<usize> = inliers.iter().map(|&k| pairs[k].0).collect();
+        let mut index = 0;
+        self.tracks.retain(|t| {
+            let keep = t.point.is_none() || inlier_tracks.contains(&index);
+            index += 1;
+            keep
+        });
+        Ok(Some(pose))
+    }
+
+    /// Relocalisation: ORB features of this frame matched to map-point descriptors, then PnP.
+    fn relocalise(&mut self, frame: &Frame) -> Result<Option<Se3>, TrackerError> {
+        let described: Vec<(u64, DVec3, crate::map::Descriptor)> = self
+            .map
+            .points
+            .values()
+            .filter_map(|p| Some((p.id, p.position, p.descriptor?)))
+            .collect();
+        if described.len() < 30 {
+            return Ok(None);
+        }
+        let features = self.orb.detect(&frame.image)?;
+        let mut matches: Vec<(u64, DVec3, Vec2)> = Vec::new();
+        for (pixel, descriptor) in &features {
+            let (mut best, mut second, mut best_k) = (u32::MAX, u32::MAX, 0);
+            for (k, (_, _, d)) in described.iter().enumerate() {
+                let dist = cv::hamming(descriptor, d);
+                if dist < best {
+                    (second, best, best_k) = (best, dist, k);
+                } else if dist < second {
+                    second = dist;
+                }
+            }
+            if best <= 50 && (best as f64) < 0.8 * second as f64 {
+                matches.push((described[best_k].0, described[best_k].1, *pixel));
+            }
+        }
+        let world: Vec<DVec3> = matches.iter().map(|m| m.1).collect();
+        let image: Vec<DVec2> = matches
+            .iter()
+            .map(|m| normalized(&self.camera, m.2))
+            .collect();
+        let found = cv::pnp_ransac(&self.camera, &world, &image, None, 4.0)?;
+        if std::env::var_os("SYLVA_TRACE").is_some() {
+            eprintln!(
+                "reloc {}: described {} features {} matches {} inliers {:?}",
+                frame.index,
+                described.len(),
+                features.len(),
+                matches.len(),
+                found.as_ref().map(|f| f.1.len())
+            );
+        }
+        let Some((pose, inliers)) = found else {
+            return Ok(None);
+        };
+        if inliers.len() < 25 {
+            return Ok(None);
+        }
+        let (w, n): (Vec<DVec3>, Vec<DVec2>) =
+            inliers.iter().map(|&k| (world[k], image[k])).unzip();
+        let pose = refine_pose(pose, &w, &n, &self.ba_config(10));
+        self.tracks = inliers
+            .iter()
+            .map(|&k| Track {
+                pixel: matches[k].2,
+                point: Some(matches[k].0),
+                origin: None,
+            })
+            .collect();
+        self.prev_pose = None;
+        Ok(Some(pose))
+    }
+
+    /// The per-frame output, in the world frame.
+    pub(crate) fn output(&self, frame: &Frame, pose: Option<Se3>) -> FrameOutput {
+        let world = self.world.as_ref();
+        let to_world = |p: DVec3| world.map_or(p, |w| w.world_from_map.transform_point(p));
+        let tracked_points = if pose.is_some() {
+            self.tracks
+                .iter()
+                .filter_map(|t| {
+                    let point = self.map.points.get(&t.point?)?;
+                    Some(TrackedPoint {
+                        id: point.id,
+                        pixel: t.pixel,
+                        world: to_world(point.position).as_vec3(),
+                    })
+                })
+                .collect()
+        } else {
+            Vec::new()
+        };
+        FrameOutput {
+            index: frame.index,
+            timestamp_s: frame.timestamp_s,
+            state: self.state,
+            world_from_camera: pose.map(|p| self.world_from_camera(&p)),
+            tracked_points,
+            plane: world.map(|w| w.plane_in_world()).map(|p: Plane| p),
+        }
+    }
+
+    /// `world_from_camera` of a map-frame `camera_from_world`.
+    pub(crate) fn world_from_camera(&self, camera_from_map: &Se3) -> DAffine3 {
+        let map_from_camera = camera_from_map.inverse();
+        match self.world.as_ref() {
+            Some(w) => w.world_from_camera(&map_from_camera),
+            None => map_from_camera.to_affine(),
+        }
+    }
+}
