@@ -1,1 +1,0 @@
-//! (module edit: being written)

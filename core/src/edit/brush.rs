@@ -1,0 +1,280 @@
+//! Brushing and sketching (Longay 2014 §5.2.1, §5.2.3, §5.2.4, appendix B).
+//!
+//! A brush is a sphere of radius ρ that moves along a stroke on a brush plane given by the
+//! caller (by default the plane through the tree's base parallel to the screen). While growth
+//! iterations run, the stroke continually adds uniformly random persistent attraction points in
+//! the volume swept since the last iteration; ρ may change from one stroke point to the next. As
+//! ρ → 0 the points lie on the stroke itself and brushing becomes sketching: the single axis
+//! that eats them follows the stroke.
+//!
+//! Options: sketch-based tropism (each point carries the stroke direction, which becomes the
+//! tropism T of the bud it feeds), selective growth (only the branch from a picked bud may
+//! grow), and a depth constraint (points only within a depth of a plane through the base).
+
+use glam::Vec3;
+
+use super::EditError;
+use super::prune::distance_to_segment;
+use crate::growth::{IterationStats, StepOptions, Tree};
+use crate::tree::NodeId;
+
+/// The plane strokes are drawn on: a point and a unit normal (world space).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BrushPlane {
+    pub origin: Vec3,
+    pub normal: Vec3,
+}
+
+impl BrushPlane {
+    /// The plane through `origin` with normal `normal` (normalised; an error if zero).
+    pub fn new(origin: Vec3, normal: Vec3) -> Result<BrushPlane, EditError> {
+        let normal = normal
+            .try_normalize()
+            .filter(|_| origin.is_finite())
+            .ok_or(EditError::NonFinite {
+                what: "brush plane",
+            })?;
+        Ok(BrushPlane { origin, normal })
+    }
+
+    /// Orthogonal projection of a world point onto the plane.
+    pub fn project(&self, p: Vec3) -> Vec3 {
+        p - self.normal * (p - self.origin).dot(self.normal)
+    }
+}
+
+/// A sample of the stroke: when, where (projected on the brush plane) and how wide.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StrokePoint {
+    pub time_s: f64,
+    pub position: Vec3,
+    /// Brush radius ρ (metres); 0 sketches.
+    pub radius_m: f32,
+}
+
+/// Knobs of a stroke.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct BrushSettings {
+    /// Points added per internode length of stroke travelled (at least; wide brushes add more).
+    pub points_per_internode: f32,
+    /// Points per volume of one internode-length cube swept by a wide brush.
+    pub points_per_internode_cube: f32,
+    /// Sketch-based tropism: points carry the stroke direction as the tropism of their bud.
+    pub sketch_tropism: bool,
+    /// Depth constraint: keep only points within this distance of the brush plane (metres).
+    pub depth_limit_m: Option<f32>,
+}
+
+impl Default for BrushSettings {
+    fn default() -> Self {
+        BrushSettings {
+            points_per_internode: 3.0,
+            points_per_internode_cube: 0.5,
+            sketch_tropism: false,
+            depth_limit_m: None,
+        }
+    }
+}
+
+/// One stroke in progress.
+#[derive(Clone, Debug)]
+pub struct BrushStroke {
+    plane: BrushPlane,
+    settings: BrushSettings,
+    points: Vec<StrokePoint>,
+    /// Stroke points already turned into attraction points (segments before this index).
+    emitted: usize,
+}
+
+impl BrushStroke {
+    pub fn new(plane: BrushPlane, settings: BrushSettings) -> BrushStroke {
+        BrushStroke {
+            plane,
+            settings,
+            points: Vec::new(),
+            emitted: 0,
+        }
+    }
+
+    pub fn points(&self) -> &[StrokePoint] {
+        &self.points
+    }
+
+    pub fn plane(&self) -> BrushPlane {
+        self.plane
+    }
+
+    /// Adds a stroke sample; the position is projected on the brush plane. Times must not go
+    /// back and the radius must be finite and non-negative.
+    pub fn add_point(
+        &mut self,
+        time_s: f64,
+        position: Vec3,
+        radius_m: f32,
+    ) -> Result<(), EditError> {
+        if !(position.is_finite() && time_s.is_finite()) {
+            return Err(EditError::NonFinite {
+                what: "stroke point",
+            });
+        }
+        if !(radius_m.is_finite() && radius_m >= 0.0) {
+            return Err(EditError::BadParameter {
+                name: "brush radius",
+                value: radius_m,
+            });
+        }
+        if let Some(last) = self.points.last()
+            && time_s < last.time_s
+        {
+            return Err(EditError::BadParameter {
+                name: "stroke time going back (s)",
+                value: time_s as f32,
+            });
+        }
+        self.points.push(StrokePoint {
+            time_s,
+            position: self.plane.project(position),
+            radius_m,
+        });
+        Ok(())
+    }
+
+    /// Turns the part of the stroke drawn since the last call into persistent attraction
+    /// points in `tree` (uniform in the swept spheres). Returns how many were added.
+    pub fn emit(&mut self, tree: &mut Tree) -> usize {
+        let l = tree.species.internode_length_m;
+        let mut added = 0;
+        if self.points.len() == 1 && self.emitted == 0 {
+            // A dab: points in the ball under the brush.
+            let p = self.points[0];
+            added += self.fill_segment(tree, p, p, l);
+            self.emitted = 1;
+            return added;
+        }
+        let start = self.emitted.saturating_sub(1);
+        for k in start..self.points.len().saturating_sub(1) {
+            let (a, b) = (self.points[k], self.points[k + 1]);
+            added += self.fill_segment(tree, a, b, l);
+        }
+        self.emitted = self.points.len();
+        added
+    }
+
+    /// Emits the new part of the stroke and runs one brush-guided growth iteration.
+    pub fn iterate(&mut self, tree: &mut Tree) -> IterationStats {
+        self.emit(tree);
+        tree.step(StepOptions {
+            autonomous: false,
+            scene: None,
+        })
+    }
+
+    fn fill_segment(&self, tree: &mut Tree, a: StrokePoint, b: StrokePoint, l: f32) -> usize {
+        let length = a.position.distance(b.position);
+        let radius = a.radius_m.max(b.radius_m);
+        let swept = std::f32::consts::PI * radius * radius * length
+            + 4.0 / 3.0 * std::f32::consts::PI * radius.powi(3);
+        let by_length = (length / l * self.settings.points_per_internode).ceil();
+        let by_volume = (swept / (l * l * l) * self.settings.points_per_internode_cube).ceil();
+        let count = by_length.max(by_volume).max(1.0) as usize;
+        let direction = (b.position - a.position).try_normalize();
+        let mut added = 0;
+        for _ in 0..count {
+            let t = tree.rng.next_f32();
+            let centre = a.position.lerp(b.position, t);
+            let rho = a.radius_m + (b.radius_m - a.radius_m) * t;
+            let p = centre + tree.rng.in_unit_ball() * rho;
+            if let Some(depth) = self.settings.depth_limit_m
+                && (p - self.plane.origin).dot(self.plane.normal).abs() > depth
+            {
+                continue;
+            }
+            match direction.filter(|_| self.settings.sketch_tropism) {
+                Some(d) => tree
+                    .environment
+                    .attraction
+                    .add_persistent_with_tropism(p, d),
+                None => tree.environment.attraction.add_persistent(p),
+            }
+            added += 1;
+        }
+        added
+    }
+
+    /// Distance from `p` to the stroke polyline.
+    pub fn distance_to(&self, p: Vec3) -> f32 {
+        match self.points.as_slice() {
+            [] => f32::INFINITY,
+            [only] => p.distance(only.position),
+            many => many
+                .windows(2)
+                .map(|w| distance_to_segment(p, w[0].position, w[1].position))
+                .fold(f32::INFINITY, f32::min),
+        }
+    }
+}
+
+/// Depth constraint (appendix B): removes attraction points farther than `depth_m` from the
+/// plane through the tree's base with normal `normal`. Returns how many were removed.
+pub fn apply_depth_constraint(tree: &mut Tree, normal: Vec3, depth_m: f32) -> usize {
+    let Some(normal) = normal.try_normalize() else {
+        return 0;
+    };
+    let base = tree
+        .skeleton
+        .internodes
+        .first()
+        .map_or(Vec3::ZERO, |n| n.start);
+    let points = &mut tree.environment.attraction.points;
+    let before = points.len();
+    points.retain(|p| (p.position - base).dot(normal).abs() <= depth_m);
+    before - points.len()
+}
+
+/// Selective growth (§5.2.4): the living bud nearest `pick` is re-oriented along the stroke's
+/// initial direction and only the branch growing from it may grow until
+/// [`end_selective_growth`]. All buds still consume points in their occupancy zones.
+/// Returns the internode carrying the bud.
+pub fn begin_selective_growth(
+    tree: &mut Tree,
+    pick: Vec3,
+    initial_direction: Vec3,
+) -> Result<NodeId, EditError> {
+    let direction = initial_direction
+        .try_normalize()
+        .filter(|_| pick.is_finite())
+        .ok_or(EditError::NonFinite {
+            what: "selective growth pick or direction",
+        })?;
+    let mut best: Option<(NodeId, Option<usize>, f32)> = None;
+    for (i, node) in tree.skeleton.internodes.iter().enumerate() {
+        let d = node.end.distance(pick);
+        if best.is_some_and(|b| b.2 <= d) {
+            continue;
+        }
+        let bud = if node.terminal_bud.as_ref().is_some_and(|b| b.alive) {
+            Some(None)
+        } else {
+            node.lateral_buds.iter().position(|b| b.alive).map(Some)
+        };
+        if let Some(which) = bud {
+            best = Some((NodeId(i as u32), which, d));
+        }
+    }
+    let (node, which, _) = best.ok_or(EditError::NoLivingBud)?;
+    let internode = &mut tree.skeleton.internodes[node.index()];
+    let bud = match which {
+        None => internode.terminal_bud.as_mut(),
+        Some(k) => internode.lateral_buds.get_mut(k),
+    };
+    if let Some(bud) = bud {
+        bud.direction = direction;
+    }
+    tree.growth_mask = Some(node);
+    Ok(node)
+}
+
+/// Leaves selective growth: every bud may grow again.
+pub fn end_selective_growth(tree: &mut Tree) {
+    tree.growth_mask = None;
+}
