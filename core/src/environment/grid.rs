@@ -101,8 +101,21 @@ impl SpatialGrid {
     /// Calls `f(index, position, distance²)` for every stored point within `radius` of `center`,
     /// cell by cell and, within a cell, in input order (deterministic).
     pub fn for_each_within(&self, center: Vec3, radius: f32, mut f: impl FnMut(u32, Vec3, f32)) {
+        self.scan(center, radius, |i, p, d2| {
+            f(i, p, d2);
+            false
+        });
+    }
+
+    /// True when some stored point lies within `radius` of `center` (stops at the first).
+    pub fn any_within(&self, center: Vec3, radius: f32) -> bool {
+        self.scan(center, radius, |_, _, _| true)
+    }
+
+    /// Visits the points within `radius` until `f` returns true; returns whether it did.
+    fn scan(&self, center: Vec3, radius: f32, mut f: impl FnMut(u32, Vec3, f32) -> bool) -> bool {
         if self.entry_index.is_empty() {
-            return;
+            return false;
         }
         let r2 = radius * radius;
         let lo = ((center - Vec3::splat(radius) - self.origin) * self.inv_cell_size)
@@ -112,7 +125,7 @@ impl SpatialGrid {
             .floor()
             .as_ivec3();
         if hi.cmplt(IVec3::ZERO).any() || lo.cmpge(self.dims).any() {
-            return;
+            return false;
         }
         let lo = lo.max(IVec3::ZERO);
         let hi = hi.min(self.dims - IVec3::ONE);
@@ -125,19 +138,13 @@ impl SpatialGrid {
                 for slot in start..end {
                     let p = self.entry_position[slot];
                     let d2 = p.distance_squared(center);
-                    if d2 <= r2 {
-                        f(self.entry_index[slot], p, d2);
+                    if d2 <= r2 && f(self.entry_index[slot], p, d2) {
+                        return true;
                     }
                 }
             }
         }
-    }
-
-    /// True when some stored point lies within `radius` of `center`.
-    pub fn any_within(&self, center: Vec3, radius: f32) -> bool {
-        let mut found = false;
-        self.for_each_within(center, radius, |_, _, _| found = true);
-        found
+        false
     }
 }
 

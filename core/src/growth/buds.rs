@@ -32,6 +32,9 @@ pub(crate) struct BudState {
     pub enabled: bool,
     /// In the selective-growth mask (or no mask set).
     pub may_grow: bool,
+    /// Takes part in the competition for space this iteration (may grow and is not in full
+    /// shade when light matters).
+    pub competes: bool,
 }
 
 /// Fills `scratch.buds` with every living bud, node by node (terminal first), and the mask.
@@ -70,6 +73,7 @@ pub(crate) fn collect(tree: &Tree, scratch: &mut Scratch) {
                 num_points: 0,
                 enabled: false,
                 may_grow,
+                competes: may_grow,
             });
         };
         if let Some(bud) = &node.terminal_bud

@@ -29,6 +29,12 @@ pub(crate) fn radii(tree: &Tree) -> (f32, f32, f32) {
 /// Runs step 2; returns the number of attraction points that survived occupancy.
 pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOptions) -> usize {
     let (r, perception, cos_half) = radii(tree);
+    // A bud in full shade (L = 0) can never grow when κ > 0 (Q = b·0^κ = 0): it neither generates
+    // nor takes points, which keeps dense crowns cheap without changing which buds grow.
+    let light_matters = tree.species.light_sensitivity > 0.0;
+    for bud in &mut scratch.buds {
+        bud.competes = bud.may_grow && (!light_matters || bud.light > 0.0);
+    }
     if options.autonomous {
         generate_points(tree, scratch, r, perception, cos_half);
     }
@@ -69,7 +75,7 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
             .bud_grid
             .for_each_within(point.position, perception, |bi, bud_pos, d2| {
                 let bud = &buds[bi as usize];
-                if !bud.may_grow || best.is_some_and(|(_, bd)| bd <= d2) {
+                if !bud.competes || best.is_some_and(|(_, bd)| bd <= d2) {
                     return;
                 }
                 if (point.position - bud_pos).dot(bud.direction) >= cos_half * d2.sqrt() {
@@ -86,7 +92,7 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
         }
     }
     for bud in &mut scratch.buds {
-        bud.enabled = bud.may_grow && bud.num_points > 0;
+        bud.enabled = bud.num_points > 0;
     }
     scratch.positions.clear();
     scratch.positions.extend(points.iter().map(|p| p.position));
@@ -102,7 +108,7 @@ fn generate_points(tree: &mut Tree, scratch: &Scratch, r: f32, perception: f32, 
     let points: &mut AttractionPoints = &mut tree.environment.attraction;
     let rng: &mut Rng = &mut tree.rng;
     points.points.reserve(scratch.buds.len() * 2);
-    for bud in &scratch.buds {
+    for bud in scratch.buds.iter().filter(|b| b.competes) {
         let count = 1 + (extra * (bud.light / s.full_exposure).clamp(0.0, 1.0)).round() as u32;
         let (b1, b2) = bud.direction.any_orthonormal_pair();
         for _ in 0..count {
