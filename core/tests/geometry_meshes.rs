@@ -1,11 +1,12 @@
 //! Branch, leaf and fruit meshes: well-formed, crack-free, levels of detail on target, leaves
 //! turned to the light.
 
+mod support;
+
 use glam::Vec3;
 use sylva_core::geometry::synthetic::{branching_skeleton, crown_ambient};
 use sylva_core::geometry::{
-    BranchStart, FruitParams, LOD_TRIANGLE_FRACTIONS, MeshParams, TreeMesh, TreeMeshes,
-    build_meshes,
+    FruitParams, LOD_TRIANGLE_FRACTIONS, MeshParams, TreeMesh, TreeMeshes, build_meshes,
 };
 use sylva_core::tree::{Bud, Internode, NodeId, Skeleton};
 
@@ -84,64 +85,10 @@ fn levels_of_detail_are_within_ten_percent_of_100_40_15_percent() {
     }
 }
 
-/// The parent's tube around the branching point as the rings define it: closest point on the
-/// parent internode or its continuation, radius interpolated between the rings at their ends.
-fn parent_tube(
-    skeleton: &Skeleton,
-    start: &BranchStart,
-    tip_taper: f32,
-    point: Vec3,
-) -> (f32, f32) {
-    let (parent, continuation) = start.parent.expect("a lateral branch");
-    let continuation_next = |node: &Internode| {
-        node.children()
-            .map(|c| skeleton.get(c).diameter)
-            .fold(None, |best: Option<f32>, d| {
-                Some(best.map_or(d, |b| b.max(d)))
-            })
-    };
-    let mut best = (f32::INFINITY, 0.0);
-    for id in [parent, continuation] {
-        let node = skeleton.get(id);
-        let end_radius = match continuation_next(node) {
-            Some(d) => 0.5 * d,
-            None => 0.5 * node.diameter * tip_taper,
-        };
-        let axis = node.end - node.start;
-        let t = ((point - node.start).dot(axis) / axis.length_squared()).clamp(0.0, 1.0);
-        let distance = point.distance(node.start + axis * t);
-        if distance < best.0 {
-            best = (
-                distance,
-                0.5 * node.diameter + (end_radius - 0.5 * node.diameter) * t,
-            );
-        }
-    }
-    best
-}
-
-fn assert_no_cracks(skeleton: &Skeleton, meshes: &TreeMeshes, tip_taper: f32) -> usize {
-    let lod = &meshes.lods[0];
-    let mut checked = 0;
-    for start in lod.branch_starts.iter().filter(|s| s.parent.is_some()) {
-        for k in 0..=start.sides {
-            let p = Vec3::from(lod.branches.positions[(start.first_vertex + k) as usize]);
-            let (distance, radius) = parent_tube(skeleton, start, tip_taper, p);
-            assert!(
-                (distance - radius).abs() <= 0.05 * radius,
-                "branch at internode {}: ring vertex {k} is {distance} from the parent axis, radius {radius}",
-                start.node.0
-            );
-            checked += 1;
-        }
-    }
-    checked
-}
-
 #[test]
 fn every_child_branch_starts_on_its_parent_surface_within_five_percent() {
     let (skeleton, meshes, params) = synthetic_meshes(20_000);
-    let checked = assert_no_cracks(&skeleton, &meshes, params.tip_taper);
+    let checked = support::assert_no_cracks(&skeleton, &meshes, params.tip_taper);
     assert!(checked > 1_000, "only {checked} vertices checked");
 }
 
@@ -226,7 +173,7 @@ fn a_lateral_that_dominates_its_axis_continues_the_mesh_without_cracks() {
         .collect();
     assert_eq!(children.len(), 3, "children {children:?}");
     assert!(children.contains(&1) && children.contains(&5));
-    assert!(assert_no_cracks(&skeleton, &meshes, params.tip_taper) > 0);
+    assert!(support::assert_no_cracks(&skeleton, &meshes, params.tip_taper) > 0);
 }
 
 #[test]

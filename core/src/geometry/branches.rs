@@ -8,8 +8,8 @@ use std::f32::consts::{PI, TAU};
 use glam::Vec3;
 
 use super::topology::{BranchTopology, NONE};
-use super::{AmbientFn, BranchStart, MeshParams, TreeMesh, any_perpendicular, hash_unit};
-use crate::tree::{NodeId, Skeleton};
+use super::{AmbientFn, BranchStart, MeshParams, NodeGeom, TreeMesh, any_perpendicular, hash_unit};
+use crate::tree::NodeId;
 
 /// A ring of a generalized cylinder.
 #[derive(Clone, Copy, Debug)]
@@ -37,26 +37,49 @@ struct ChainRings {
     sides: u32,
     /// Bark tiles around the circumference.
     tiles_around: f32,
+    /// The parent's surface where a lateral chain starts; `None` for the trunk.
+    tube: Option<ParentTube>,
 }
 
-/// cos/sin of `k·2π/C` for k in 0..=C, for every side count C up to a maximum.
+/// cos/sin of `k·2π/C` for k in 0..=C, and the indices of the 2C triangles joining two rings
+/// (relative to the first vertex of the lower ring), for every side count C up to a maximum.
 struct SideTables {
     offsets: Vec<usize>,
     cos_sin: Vec<(f32, f32)>,
+    pattern_offsets: Vec<usize>,
+    patterns: Vec<u32>,
 }
 
 impl SideTables {
     fn new(max_sides: u32) -> Self {
         let mut offsets = vec![0; max_sides as usize + 1];
+        let mut pattern_offsets = vec![0; max_sides as usize + 1];
         let mut cos_sin = Vec::new();
+        let mut patterns = Vec::new();
         for sides in 3..=max_sides {
             offsets[sides as usize] = cos_sin.len();
+            pattern_offsets[sides as usize] = patterns.len();
             for k in 0..=sides {
                 let angle = TAU * k as f32 / sides as f32;
                 cos_sin.push((angle.cos(), angle.sin()));
             }
+            // Counter-clockwise seen from outside: (a0, a1, b1), (a0, b1, b0).
+            for k in 0..sides {
+                let (a0, a1, b0, b1) = (k, k + 1, sides + 1 + k, sides + 2 + k);
+                patterns.extend_from_slice(&[a0, a1, b1, a0, b1, b0]);
+            }
         }
-        SideTables { offsets, cos_sin }
+        SideTables {
+            offsets,
+            cos_sin,
+            pattern_offsets,
+            patterns,
+        }
+    }
+
+    fn index_pattern(&self, sides: u32) -> &[u32] {
+        let start = self.pattern_offsets[sides as usize];
+        &self.patterns[start..start + 6 * sides as usize]
     }
 
     fn get(&self, sides: u32) -> &[(f32, f32)] {
@@ -71,7 +94,6 @@ pub(crate) struct RingFrames {
     /// Chains sorted by base diameter, thickest first (parents before children on ties).
     order_by_diameter: Vec<u32>,
     tables: SideTables,
-    tip_taper: f32,
 }
 
 /// Sides C = 3·dⁿ/d_e (eq. C.2) of a branch of base diameter `d`, clamped to [3, max].
@@ -86,47 +108,71 @@ fn scaled_sides(sides: u32, side_scale: f32) -> u32 {
 }
 
 /// Radius of the parent's tube at the ends of internode `node`, as the rings draw it.
-fn end_radius(skeleton: &Skeleton, topology: &BranchTopology, node: u32, tip_taper: f32) -> f32 {
+fn end_radius(nodes: &[NodeGeom], topology: &BranchTopology, node: u32, tip_taper: f32) -> f32 {
     let next = topology.visual_child[node as usize];
     if next == NONE {
-        0.5 * skeleton.internodes[node as usize].diameter * tip_taper
+        0.5 * nodes[node as usize].diameter * tip_taper
     } else {
-        0.5 * skeleton.internodes[next as usize].diameter
+        0.5 * nodes[next as usize].diameter
     }
 }
 
-/// The parent surface near a branching point: the axis point closest to `point` on the two
-/// internodes around the joint (`parent` and its continuation), and the tube radius there.
-pub(crate) fn parent_surface_at(
-    skeleton: &Skeleton,
-    topology: &BranchTopology,
-    parent: u32,
-    tip_taper: f32,
-    point: Vec3,
-) -> (Vec3, f32) {
-    let continuation = topology.visual_child[parent as usize];
-    let below = &skeleton.internodes[parent as usize];
-    let mut best = closest_on_segment(
-        below.start,
-        below.end,
-        0.5 * below.diameter,
-        end_radius(skeleton, topology, parent, tip_taper),
-        point,
-    );
-    if continuation != NONE {
-        let above = &skeleton.internodes[continuation as usize];
-        let candidate = closest_on_segment(
-            above.start,
-            above.end,
-            0.5 * above.diameter,
-            end_radius(skeleton, topology, continuation, tip_taper),
-            point,
-        );
-        if candidate.0.distance_squared(point) < best.0.distance_squared(point) {
-            best = candidate;
+/// One internode of a parent tube: axis from `a` to `b`, radius from `radius_a` to `radius_b`.
+#[derive(Clone, Copy, Debug)]
+struct TubeSegment {
+    a: Vec3,
+    b: Vec3,
+    radius_a: f32,
+    radius_b: f32,
+}
+
+/// The parent surface near a branching point, as the parent's rings draw it: the internode the
+/// branch grows from and its continuation along the thickest path.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct ParentTube {
+    below: TubeSegment,
+    above: Option<TubeSegment>,
+}
+
+impl ParentTube {
+    fn new(nodes: &[NodeGeom], topology: &BranchTopology, parent: u32, tip_taper: f32) -> Self {
+        let segment = |node: u32| {
+            let n = &nodes[node as usize];
+            TubeSegment {
+                a: n.start,
+                b: n.end,
+                radius_a: 0.5 * n.diameter,
+                radius_b: end_radius(nodes, topology, node, tip_taper),
+            }
+        };
+        let continuation = topology.visual_child[parent as usize];
+        ParentTube {
+            below: segment(parent),
+            above: (continuation != NONE).then(|| segment(continuation)),
         }
     }
-    best
+
+    /// Radius of the tube at the branching point.
+    fn joint_radius(&self) -> f32 {
+        self.below.radius_b
+    }
+
+    /// The axis point closest to `point` and the tube radius there.
+    fn at(&self, point: Vec3) -> (Vec3, f32) {
+        let s = &self.below;
+        let best = closest_on_segment(s.a, s.b, s.radius_a, s.radius_b, point);
+        match &self.above {
+            Some(s) => {
+                let candidate = closest_on_segment(s.a, s.b, s.radius_a, s.radius_b, point);
+                if candidate.0.distance_squared(point) < best.0.distance_squared(point) {
+                    candidate
+                } else {
+                    best
+                }
+            }
+            None => best,
+        }
+    }
 }
 
 fn closest_on_segment(a: Vec3, b: Vec3, radius_a: f32, radius_b: f32, point: Vec3) -> (Vec3, f32) {
@@ -167,12 +213,11 @@ fn transport(reference: Vec3, from: Vec3, from_tangent: Vec3, to: Vec3, to_tange
 
 impl RingFrames {
     pub(crate) fn build(
-        skeleton: &Skeleton,
+        nodes: &[NodeGeom],
         topology: &BranchTopology,
         params: &MeshParams,
         ambient: AmbientFn,
     ) -> Self {
-        let nodes = &skeleton.internodes;
         let thinnest = nodes
             .iter()
             .map(|n| n.diameter)
@@ -190,11 +235,12 @@ impl RingFrames {
                 .round()
                 .max(1.0);
             let first_ring = rings.len() as u32;
+            let tube = (chain.parent_node != NONE)
+                .then(|| ParentTube::new(nodes, topology, chain.parent_node, params.tip_taper));
             push_chain_rings(
                 &mut rings,
-                skeleton,
-                topology,
-                chain.parent_node,
+                nodes,
+                tube.as_ref(),
                 chain_nodes,
                 params,
                 circumference / tiles_around,
@@ -205,6 +251,7 @@ impl RingFrames {
                 num_rings: rings.len() as u32 - first_ring,
                 sides: contour_sides(base_diameter, thinnest, params.side_exponent, max_sides),
                 tiles_around,
+                tube,
             });
         }
         let mut keyed: Vec<u64> = topology
@@ -223,18 +270,12 @@ impl RingFrames {
             chains,
             order_by_diameter: keyed.into_iter().map(|k| k as u32).collect(),
             tables: SideTables::new(max_sides),
-            tip_taper: params.tip_taper,
         }
     }
 
     /// Triangles of the branches drawn with `side_scale` of the finest sides, all chains or the
     /// `kept` ones.
-    pub(crate) fn num_triangles(
-        &self,
-        _topology: &BranchTopology,
-        side_scale: f32,
-        kept: Option<&[bool]>,
-    ) -> usize {
+    pub(crate) fn num_triangles(&self, side_scale: f32, kept: Option<&[bool]>) -> usize {
         self.chains
             .iter()
             .enumerate()
@@ -268,14 +309,17 @@ impl RingFrames {
         kept
     }
 
-    /// Emits the branch mesh with `side_scale` of the finest sides, all chains or the `kept` ones.
-    pub(crate) fn mesh(
+    /// Emits the branch mesh with `side_scale` of the finest sides, all chains or the `kept` ones,
+    /// into `mesh` and `starts` (cleared first; their capacity is reused).
+    #[allow(clippy::too_many_arguments)]
+    pub(crate) fn mesh_into(
         &self,
-        skeleton: &Skeleton,
         topology: &BranchTopology,
         side_scale: f32,
         kept: Option<&[bool]>,
-    ) -> (TreeMesh, Vec<BranchStart>) {
+        mesh: &mut TreeMesh,
+        starts: &mut Vec<BranchStart>,
+    ) {
         let is_kept = |index: usize| kept.is_none_or(|k| k[index]);
         let (mut num_vertices, mut num_indices) = (0, 0);
         for (index, chain) in self.chains.iter().enumerate() {
@@ -285,8 +329,9 @@ impl RingFrames {
                 num_indices += 6 * sides * (chain.num_rings as usize - 1);
             }
         }
-        let mut mesh = TreeMesh::with_capacity(num_vertices, num_indices);
-        let mut starts = Vec::new();
+        mesh.clear();
+        mesh.reserve(num_vertices, num_indices);
+        starts.clear();
         for (index, chain) in self.chains.iter().enumerate() {
             if !is_kept(index) || chain.num_rings < 2 {
                 continue;
@@ -304,93 +349,92 @@ impl RingFrames {
                 first_vertex: mesh.positions.len() as u32,
                 sides,
             });
-            self.emit_chain(&mut mesh, skeleton, topology, chain, sides, parent);
+            self.emit_chain(
+                mesh,
+                chain,
+                sides,
+                parent.map(|(_, parent_sides)| parent_sides),
+            );
         }
         debug_assert_eq!(mesh.positions.len(), num_vertices);
-        (mesh, starts)
     }
 
+    /// Emits one chain with `sides` sides; `parent_sides` is the side count of the parent at
+    /// this level (the first ring is laid onto a surface that polygonal).
     fn emit_chain(
         &self,
         mesh: &mut TreeMesh,
-        skeleton: &Skeleton,
-        topology: &BranchTopology,
         chain: &ChainRings,
         sides: u32,
-        parent: Option<(u32, u32)>,
+        parent_sides: Option<u32>,
     ) {
+        // Mid-radius of the parent's polygonal contour, so the joint shows no gap.
+        let shrink = parent_sides.map(|c| (0.5 * (1.0 + (PI / c as f32).cos())).max(0.96));
         let table = self.tables.get(sides);
+        let pattern = self.tables.index_pattern(sides);
         let rings =
             &self.rings[chain.first_ring as usize..(chain.first_ring + chain.num_rings) as usize];
         let du = chain.tiles_around / sides as f32;
+        let ring_size = sides as usize + 1;
         for (ring_index, ring) in rings.iter().enumerate() {
             let base = mesh.positions.len() as u32;
-            for (k, &(cos, sin)) in table.iter().enumerate() {
-                let direction = ring.reference * cos + ring.binormal * sin;
-                let mut position = ring.center + direction * ring.radius;
-                if ring_index == 0
-                    && let Some((parent_node, parent_sides)) = parent
-                {
-                    position = self.onto_parent(
-                        skeleton,
-                        topology,
-                        ring,
-                        direction,
-                        parent_node,
-                        parent_sides,
+            let direction = |&(cos, sin): &(f32, f32)| ring.reference * cos + ring.binormal * sin;
+            match (chain.tube.as_ref(), shrink) {
+                (Some(tube), Some(shrink)) if ring_index == 0 => {
+                    mesh.positions.extend(
+                        table
+                            .iter()
+                            .map(|cs| onto_parent(tube, ring, direction(cs), shrink).to_array()),
                     );
                 }
-                let uv = [k as f32 * du + ring.u_offset, ring.v];
-                mesh.push_vertex(position, direction, uv, ring.ambient);
+                _ => mesh.positions.extend(
+                    table
+                        .iter()
+                        .map(|cs| (ring.center + direction(cs) * ring.radius).to_array()),
+                ),
             }
+            mesh.normals
+                .extend(table.iter().map(|cs| direction(cs).to_array()));
+            mesh.uvs
+                .extend((0..ring_size).map(|k| [k as f32 * du + ring.u_offset, ring.v]));
+            mesh.ambient
+                .extend(std::iter::repeat_n(ring.ambient, ring_size));
             if ring_index > 0 {
-                let below = base - (sides + 1);
-                for k in 0..sides {
-                    let (a0, a1, b0, b1) = (below + k, below + k + 1, base + k, base + k + 1);
-                    mesh.indices.extend_from_slice(&[a0, a1, b1, a0, b1, b0]);
-                }
+                let below = base - ring_size as u32;
+                mesh.indices
+                    .extend(pattern.iter().map(|&offset| below + offset));
             }
         }
     }
+}
 
-    /// Lays a vertex of a lateral branch's first ring onto its parent's surface: slides it along
-    /// the branch tangent until it leaves the parent tube, then projects it radially onto the
-    /// tube (shrunk to the mid-radius of the parent's polygonal contour, so no gap shows).
-    fn onto_parent(
-        &self,
-        skeleton: &Skeleton,
-        topology: &BranchTopology,
-        ring: &Ring,
-        direction: Vec3,
-        parent_node: u32,
-        parent_sides: u32,
-    ) -> Vec3 {
-        let shrink = (0.5 * (1.0 + (PI / parent_sides as f32).cos())).max(0.96);
-        let start = ring.center + direction * ring.radius;
-        let surface = |p| parent_surface_at(skeleton, topology, parent_node, self.tip_taper, p);
-        let (_, joint_radius) = surface(ring.center);
-        let max_slide = 3.0 * joint_radius;
-        let mut slide = 0.0f32;
-        for _ in 0..3 {
-            let point = start + ring.tangent * slide;
-            let (axis, radius) = surface(point);
-            let offset = point - axis;
-            let distance = offset.length();
-            let gap = radius * shrink - distance;
-            if gap <= 1e-4 * radius || distance < 1e-9 {
-                break;
-            }
-            let rate = ring.tangent.dot(offset / distance).max(0.25);
-            slide = (slide + gap / rate).min(max_slide);
-        }
+/// Lays a vertex of a lateral branch's first ring onto its parent's surface: slides it along
+/// the branch tangent until it leaves the parent tube, then projects it radially onto the
+/// tube (shrunk to the mid-radius of the parent's polygonal contour, so no gap shows).
+fn onto_parent(tube: &ParentTube, ring: &Ring, direction: Vec3, shrink: f32) -> Vec3 {
+    let start = ring.center + direction * ring.radius;
+    let surface = |p| tube.at(p);
+    let max_slide = 3.0 * tube.joint_radius();
+    let mut slide = 0.0f32;
+    for _ in 0..1 {
         let point = start + ring.tangent * slide;
         let (axis, radius) = surface(point);
-        let outward = (point - axis)
-            .try_normalize()
-            .or_else(|| direction.try_normalize())
-            .unwrap_or(Vec3::X);
-        axis + outward * radius * shrink
+        let offset = point - axis;
+        let distance = offset.length();
+        let gap = radius * shrink - distance;
+        if gap <= 1e-4 * radius || distance < 1e-9 {
+            break;
+        }
+        let rate = ring.tangent.dot(offset / distance).max(0.25);
+        slide = (slide + gap / rate).min(max_slide);
     }
+    let point = start + ring.tangent * slide;
+    let (axis, radius) = surface(point);
+    let outward = (point - axis)
+        .try_normalize()
+        .or_else(|| direction.try_normalize())
+        .unwrap_or(Vec3::X);
+    axis + outward * radius * shrink
 }
 
 fn chain_triangles(chain: &ChainRings, side_scale: f32) -> usize {
@@ -406,15 +450,13 @@ fn chain_triangles(chain: &ChainRings, side_scale: f32) -> usize {
 #[allow(clippy::too_many_arguments)]
 fn push_chain_rings(
     rings: &mut Vec<Ring>,
-    skeleton: &Skeleton,
-    topology: &BranchTopology,
-    parent_node: u32,
+    nodes: &[NodeGeom],
+    tube: Option<&ParentTube>,
     chain_nodes: &[u32],
     params: &MeshParams,
     tile_length: f32,
     ambient: AmbientFn,
 ) {
-    let nodes = &skeleton.internodes;
     let first = &nodes[chain_nodes[0] as usize];
     let mut previous = Ring {
         center: first.start,
@@ -430,18 +472,11 @@ fn push_chain_rings(
         .try_normalize()
         .unwrap_or_else(|| any_perpendicular(previous.tangent));
     previous.binormal = previous.tangent.cross(previous.reference);
-    if parent_node != NONE {
-        let (_, joint_radius) = parent_surface_at(
-            skeleton,
-            topology,
-            parent_node,
-            params.tip_taper,
-            first.start,
-        );
-        previous.radius = previous.radius.min(0.85 * joint_radius);
+    if let Some(tube) = tube {
+        previous.radius = previous.radius.min(0.85 * tube.joint_radius());
     }
     rings.push(previous);
-    let mut inside_parent = parent_node != NONE;
+    let mut inside_parent = tube.is_some();
     let mut arc_length = 0.0;
     for (k, &node_index) in chain_nodes.iter().enumerate() {
         let node = &nodes[node_index as usize];
@@ -459,9 +494,8 @@ fn push_chain_rings(
             }
             None => (heading, 0.5 * node.diameter * params.tip_taper),
         };
-        if inside_parent {
-            let (axis, parent_radius) =
-                parent_surface_at(skeleton, topology, parent_node, params.tip_taper, node.end);
+        if let Some(tube) = tube.filter(|_| inside_parent) {
+            let (axis, parent_radius) = tube.at(node.end);
             if node.end.distance(axis) < parent_radius {
                 continue;
             }

@@ -14,7 +14,7 @@
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
-use super::{AmbientFn, TreeMesh, any_perpendicular, hash_unit};
+use super::{AmbientFn, NodeGeom, TreeMesh, any_perpendicular, hash_unit};
 use crate::rng::Rng;
 use crate::tree::Skeleton;
 
@@ -90,9 +90,14 @@ impl Default for FruitParams {
 /// A leaf to be made: the internode, position along it (0..1) and spiral angle.
 #[derive(Clone, Copy)]
 struct LeafSlot {
-    node: u32,
-    along: f32,
-    angle: f32,
+    /// Where the petiole leaves the branch surface.
+    attachment: Vec3,
+    /// The branch heading there.
+    heading: Vec3,
+    /// Unit direction from the branch axis to the attachment.
+    radial: Vec3,
+    /// Ambient light at the attachment.
+    light: f32,
 }
 
 /// All leaves of the skeleton as quads (4 vertices, 6 indices each) in random order.
@@ -102,60 +107,93 @@ pub fn build_leaves(
     seed: u64,
     ambient: AmbientFn,
 ) -> TreeMesh {
-    let mut slots = Vec::new();
-    let mut spiral = 0.0f32;
-    for (index, node) in skeleton.internodes.iter().enumerate() {
+    let mut mesh = TreeMesh::default();
+    build_leaves_into(
+        &NodeGeom::collect(skeleton),
+        params,
+        seed,
+        ambient,
+        &mut mesh,
+    );
+    mesh
+}
+
+/// [`build_leaves`] into `mesh` (cleared first, capacity reused).
+pub(crate) fn build_leaves_into(
+    nodes: &[NodeGeom],
+    params: &LeafParams,
+    seed: u64,
+    ambient: AmbientFn,
+    mesh: &mut TreeMesh,
+) {
+    // Slots are made walking the arena in order (its memory and the shadow grid stay in cache)
+    // and land at random places by the inside-out Fisher–Yates shuffle.
+    let mut slots: Vec<LeafSlot> = Vec::new();
+    let mut rng = Rng::new(seed ^ 0x1eaf);
+    // The spiral turns by the golden angle per leaf: a running complex product, renormalised.
+    let (golden_sin, golden_cos) = GOLDEN_ANGLE.sin_cos();
+    let mut spiral = (1.0f32, 0.0f32);
+    for (index, node) in nodes.iter().enumerate() {
         if node.diameter >= params.max_branch_diameter {
             continue;
         }
         let expected = params.leaves_per_metre * node.length();
         let jitter = hash_unit(seed ^ ((index as u64) << 20));
         let count = (expected + jitter) as u32;
+        if count == 0 {
+            continue;
+        }
+        let heading = node.heading();
+        let left = (node.left - heading * node.left.dot(heading))
+            .try_normalize()
+            .unwrap_or_else(|| any_perpendicular(heading));
+        let up = heading.cross(left);
         for k in 0..count {
-            spiral = (spiral + GOLDEN_ANGLE) % std::f32::consts::TAU;
-            slots.push(LeafSlot {
-                node: index as u32,
-                along: (k as f32 + 0.5) / count as f32,
-                angle: spiral,
-            });
+            let (c, s) = spiral;
+            let (c, s) = (
+                c * golden_cos - s * golden_sin,
+                c * golden_sin + s * golden_cos,
+            );
+            let norm = (c * c + s * s).sqrt();
+            spiral = (c / norm, s / norm);
+            let radial = left * spiral.0 + up * spiral.1;
+            let along = (k as f32 + 0.5) / count as f32;
+            let attachment = node.start.lerp(node.end, along) + radial * (0.5 * node.diameter);
+            let slot = LeafSlot {
+                attachment,
+                heading,
+                radial,
+                light: ambient(attachment).clamp(0.0, 1.0),
+            };
+            let i = slots.len();
+            let j = rng.below(i as u32 + 1) as usize;
+            slots.push(slot);
+            slots.swap(i, j);
         }
     }
-    let mut rng = Rng::new(seed ^ 0x1eaf);
-    for i in (1..slots.len()).rev() {
-        let j = rng.below(i as u32 + 1) as usize;
-        slots.swap(i, j);
-    }
-    let mut mesh = TreeMesh::with_capacity(slots.len() * 4, slots.len() * 6);
+    mesh.clear();
+    mesh.reserve(slots.len() * 4, slots.len() * 6);
     let target = Vec3::from(params.light_direction)
         .try_normalize()
         .unwrap_or(Vec3::Y);
     for slot in &slots {
-        push_leaf(&mut mesh, skeleton, params, target, slot, ambient);
+        push_leaf(mesh, params, target, slot);
     }
-    mesh
 }
 
-fn push_leaf(
-    mesh: &mut TreeMesh,
-    skeleton: &Skeleton,
-    params: &LeafParams,
-    target: Vec3,
-    slot: &LeafSlot,
-    ambient: AmbientFn,
-) {
-    let node = &skeleton.internodes[slot.node as usize];
-    let heading = node.heading();
-    let left = (node.left - heading * node.left.dot(heading))
-        .try_normalize()
-        .unwrap_or_else(|| any_perpendicular(heading));
-    let up = heading.cross(left);
-    let (sin_a, cos_a) = slot.angle.sin_cos();
-    let radial = left * cos_a + up * sin_a;
-    let attachment = node.start.lerp(node.end, slot.along) + radial * (0.5 * node.diameter);
-    let light = ambient(attachment).clamp(0.0, 1.0);
+fn push_leaf(mesh: &mut TreeMesh, params: &LeafParams, target: Vec3, slot: &LeafSlot) {
+    let LeafSlot {
+        attachment,
+        heading,
+        radial,
+        light,
+    } = *slot;
     let (sin_i, cos_i) = params.insertion_angle.sin_cos();
     let mut h = heading * cos_i + radial * sin_i;
-    let mut l = heading.cross(radial).try_normalize().unwrap_or(left);
+    let mut l = heading
+        .cross(radial)
+        .try_normalize()
+        .unwrap_or_else(|| any_perpendicular(h));
     let steps = params.petiole_steps.max(1);
     let ds = params.petiole_length / steps as f32;
     let mut position = attachment;
@@ -164,13 +202,12 @@ fn push_leaf(
         let omega_h = -params.twist_rate * l.dot(target);
         let omega_l = params.bend_rate * h.dot(target);
         let omega_u = params.turn_rate * l.dot(target.cross(h.cross(target)));
-        let omega = (h * omega_h + l * omega_l + u * omega_u) * light;
-        let angle = omega.length() * ds;
-        if angle > 1e-6 {
-            let axis = omega / omega.length();
-            h = rotate(h, axis, angle);
-            l = rotate(l, axis, angle);
-        }
+        // Rotation by the vector Ω·Δs, through the quaternion (Ω·Δs/2, 1) normalised: no
+        // trigonometry, and the angle 2·atan(|Ω|Δs/2) equals |Ω|Δs to first order.
+        let half = (h * omega_h + l * omega_l + u * omega_u) * (0.5 * light * ds);
+        let rotation = glam::Quat::from_xyzw(half.x, half.y, half.z, 1.0).normalize();
+        h = rotation * h;
+        l = rotation * l;
         position += h * ds;
     }
     let h = h.try_normalize().unwrap_or(heading);
@@ -201,6 +238,17 @@ fn rotate(v: Vec3, axis: Vec3, angle: f32) -> Vec3 {
 /// icosahedron hanging from its bud, the bud direction rotated down by the droop angle.
 pub fn build_fruit(skeleton: &Skeleton, params: &FruitParams, ambient: AmbientFn) -> TreeMesh {
     let mut mesh = TreeMesh::default();
+    build_fruit_into(skeleton, params, ambient, &mut mesh);
+    mesh
+}
+
+/// [`build_fruit`] appended to `mesh`.
+pub fn build_fruit_into(
+    skeleton: &Skeleton,
+    params: &FruitParams,
+    ambient: AmbientFn,
+    mesh: &mut TreeMesh,
+) {
     for (index, node) in skeleton.internodes.iter().enumerate() {
         if node.diameter >= params.max_branch_diameter {
             continue;
@@ -214,15 +262,9 @@ pub fn build_fruit(skeleton: &Skeleton, params: &FruitParams, ambient: AmbientFn
             }
             let down = droop(bud.direction, params.droop);
             let center = node.end + down * (params.radius * 1.2);
-            push_icosahedron(
-                &mut mesh,
-                center,
-                params.radius,
-                ambient(center).clamp(0.0, 1.0),
-            );
+            push_icosahedron(mesh, center, params.radius, ambient(center).clamp(0.0, 1.0));
         }
     }
-    mesh
 }
 
 /// Bud direction rotated towards −Y by `angle` (not past straight down).

@@ -20,6 +20,7 @@
 
 mod branches;
 pub mod leaves;
+mod looks;
 pub mod synthetic;
 pub mod textures;
 pub mod topology;
@@ -30,6 +31,7 @@ use serde::{Deserialize, Serialize};
 use crate::tree::{NodeId, Skeleton};
 
 pub use leaves::{FruitParams, LeafParams};
+pub use looks::{build_tree_meshes, build_tree_meshes_with, mesh_params_for};
 pub use topology::BranchTopology;
 
 /// Ambient light at a world point: 1 = unshaded sky, 0 = full shade.
@@ -66,7 +68,7 @@ pub struct MeshParams {
 impl Default for MeshParams {
     fn default() -> Self {
         MeshParams {
-            max_sides: 24,
+            max_sides: 16,
             side_exponent: 1.0,
             bark_tile_size: 0.25,
             bark_twist: 0.02,
@@ -104,6 +106,23 @@ impl TreeMesh {
             ambient: Vec::with_capacity(num_vertices),
             indices: Vec::with_capacity(num_indices),
         }
+    }
+
+    /// Empties the mesh, keeping its capacity.
+    pub fn clear(&mut self) {
+        self.positions.clear();
+        self.normals.clear();
+        self.uvs.clear();
+        self.ambient.clear();
+        self.indices.clear();
+    }
+
+    pub fn reserve(&mut self, num_vertices: usize, num_indices: usize) {
+        self.positions.reserve(num_vertices);
+        self.normals.reserve(num_vertices);
+        self.uvs.reserve(num_vertices);
+        self.ambient.reserve(num_vertices);
+        self.indices.reserve(num_indices);
     }
 
     pub fn num_vertices(&self) -> usize {
@@ -183,7 +202,7 @@ impl Lod {
 }
 
 /// Colours of the materials, linear RGB.
-#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct MaterialColors {
     pub bark: [f32; 3],
     pub leaf: [f32; 3],
@@ -192,7 +211,7 @@ pub struct MaterialColors {
 
 /// Every mesh of a tree: branches per level of detail, one randomly ordered leaf buffer and one
 /// fruit buffer whose prefixes the levels draw.
-#[derive(Clone, Debug, PartialEq)]
+#[derive(Clone, Debug, Default, PartialEq)]
 pub struct TreeMeshes {
     /// Finest first.
     pub lods: Vec<Lod>,
@@ -226,50 +245,96 @@ impl TreeMeshes {
 /// Builds the branch, leaf and fruit meshes of `skeleton` at the three levels of detail of
 /// [`LOD_TRIANGLE_FRACTIONS`], sampling `ambient` once per ring, leaf and fruit.
 pub fn build_meshes(skeleton: &Skeleton, params: &MeshParams, ambient: AmbientFn) -> TreeMeshes {
+    let mut meshes = TreeMeshes::default();
+    build_meshes_into(skeleton, params, ambient, &mut meshes);
+    meshes
+}
+
+/// [`build_meshes`] into existing meshes, reusing their buffers: interactive re-meshing after
+/// every edit allocates nothing once the buffers have grown.
+pub fn build_meshes_into(
+    skeleton: &Skeleton,
+    params: &MeshParams,
+    ambient: AmbientFn,
+    meshes: &mut TreeMeshes,
+) {
+    let nodes = NodeGeom::collect(skeleton);
     let topology = BranchTopology::build(skeleton);
-    let rings = branches::RingFrames::build(skeleton, &topology, params, ambient);
-    let leaves = leaves::build_leaves(skeleton, &params.leaves, params.seed, ambient);
-    let fruit = match &params.fruit {
-        Some(fruit) => leaves::build_fruit(skeleton, fruit, ambient),
-        None => TreeMesh::default(),
-    };
-    let num_branch_triangles_full = rings.num_triangles(&topology, 1.0, None);
-    let lods = LOD_TRIANGLE_FRACTIONS
-        .iter()
-        .map(|&fraction| {
-            let (branches, branch_starts) = if fraction >= 1.0 {
-                rings.mesh(skeleton, &topology, 1.0, None)
-            } else {
-                let target = (num_branch_triangles_full as f32 * fraction) as usize;
-                let side_scale = fraction.sqrt();
-                let kept = rings.chains_within_budget(&topology, side_scale, target);
-                rings.mesh(skeleton, &topology, side_scale, Some(&kept))
-            };
-            Lod {
-                target_fraction: fraction,
-                branches,
-                branch_starts,
-                num_leaf_indices: prefix_indices(leaves.indices.len(), 6, fraction),
-                num_fruit_indices: prefix_indices(fruit.indices.len(), 3, fraction),
-            }
-        })
-        .collect();
-    TreeMeshes {
-        lods,
-        leaves,
-        fruit,
-        colors: MaterialColors {
-            bark: params.bark_color,
-            leaf: params.leaf_color,
-            fruit: params.fruit_color,
-        },
+    let rings = branches::RingFrames::build(&nodes, &topology, params, ambient);
+    leaves::build_leaves_into(
+        &nodes,
+        &params.leaves,
+        params.seed,
+        ambient,
+        &mut meshes.leaves,
+    );
+    meshes.fruit.clear();
+    if let Some(fruit) = &params.fruit {
+        leaves::build_fruit_into(skeleton, fruit, ambient, &mut meshes.fruit);
     }
+    let num_branch_triangles_full = rings.num_triangles(1.0, None);
+    meshes
+        .lods
+        .resize_with(LOD_TRIANGLE_FRACTIONS.len(), Lod::default);
+    for (lod, &fraction) in meshes.lods.iter_mut().zip(&LOD_TRIANGLE_FRACTIONS) {
+        let (mesh, starts) = (&mut lod.branches, &mut lod.branch_starts);
+        if fraction >= 1.0 {
+            rings.mesh_into(&topology, 1.0, None, mesh, starts);
+        } else {
+            let target = (num_branch_triangles_full as f32 * fraction) as usize;
+            let side_scale = fraction.sqrt();
+            let kept = rings.chains_within_budget(&topology, side_scale, target);
+            rings.mesh_into(&topology, side_scale, Some(&kept), mesh, starts);
+        }
+        lod.target_fraction = fraction;
+        lod.num_leaf_indices = prefix_indices(meshes.leaves.indices.len(), 6, fraction);
+        lod.num_fruit_indices = prefix_indices(meshes.fruit.indices.len(), 3, fraction);
+    }
+    meshes.colors = MaterialColors {
+        bark: params.bark_color,
+        leaf: params.leaf_color,
+        fruit: params.fruit_color,
+    };
 }
 
 /// The number of indices of a `fraction` prefix, rounded to whole primitives of `unit` indices.
 fn prefix_indices(num_indices: usize, unit: usize, fraction: f32) -> usize {
     let units = num_indices / unit;
     ((units as f32 * fraction).round() as usize).min(units) * unit
+}
+
+/// The geometry of one internode, copied out of the skeleton in one sequential pass: meshing
+/// walks chains and leaves in orders that jump around the arena, and this compact copy keeps
+/// those jumps in cache.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct NodeGeom {
+    pub start: Vec3,
+    pub end: Vec3,
+    pub left: Vec3,
+    pub diameter: f32,
+}
+
+impl NodeGeom {
+    pub(crate) fn collect(skeleton: &Skeleton) -> Vec<NodeGeom> {
+        skeleton
+            .internodes
+            .iter()
+            .map(|n| NodeGeom {
+                start: n.start,
+                end: n.end,
+                left: n.left,
+                diameter: n.diameter,
+            })
+            .collect()
+    }
+
+    pub(crate) fn heading(&self) -> Vec3 {
+        (self.end - self.start).try_normalize().unwrap_or(Vec3::Y)
+    }
+
+    pub(crate) fn length(&self) -> f32 {
+        (self.end - self.start).length()
+    }
 }
 
 /// Deterministic hash of an integer to [0, 1): placement jitter and the fruit lottery r.

@@ -1,9 +1,13 @@
-//! Helpers shared by the export tests: the Khronos validator and the re-import check.
+//! Helpers shared by the geometry and export tests: the crack check, the Khronos validator and
+//! the re-import check. Each test file uses some of them.
+#![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use sylva_core::geometry::TreeMeshes;
+use glam::Vec3;
+use sylva_core::geometry::{BranchStart, TreeMeshes};
+use sylva_core::tree::{Internode, Skeleton};
 
 pub struct ValidatorReport {
     pub num_errors: u64,
@@ -118,4 +122,58 @@ pub fn assert_reimport_matches(path: &Path, meshes: &TreeMeshes) {
     assert!(meshes.leaves.num_triangles() > 0, "the tree has leaves");
     assert_eq!(images.len(), 2, "bark and leaf images");
     assert!(images.iter().all(|i| i.width >= 64 && i.height >= 64));
+}
+
+/// The parent's tube around the branching point as the rings define it: closest point on the
+/// parent internode or its continuation, radius interpolated between the rings at their ends.
+fn parent_tube(
+    skeleton: &Skeleton,
+    start: &BranchStart,
+    tip_taper: f32,
+    point: Vec3,
+) -> (f32, f32) {
+    let (parent, continuation) = start.parent.expect("a lateral branch");
+    let continuation_next = |node: &Internode| {
+        node.children()
+            .map(|c| skeleton.get(c).diameter)
+            .fold(None, |best: Option<f32>, d| {
+                Some(best.map_or(d, |b| b.max(d)))
+            })
+    };
+    let mut best = (f32::INFINITY, 0.0);
+    for id in [parent, continuation] {
+        let node = skeleton.get(id);
+        let end_radius = match continuation_next(node) {
+            Some(d) => 0.5 * d,
+            None => 0.5 * node.diameter * tip_taper,
+        };
+        let axis = node.end - node.start;
+        let t = ((point - node.start).dot(axis) / axis.length_squared()).clamp(0.0, 1.0);
+        let distance = point.distance(node.start + axis * t);
+        if distance < best.0 {
+            best = (
+                distance,
+                0.5 * node.diameter + (end_radius - 0.5 * node.diameter) * t,
+            );
+        }
+    }
+    best
+}
+
+pub fn assert_no_cracks(skeleton: &Skeleton, meshes: &TreeMeshes, tip_taper: f32) -> usize {
+    let lod = &meshes.lods[0];
+    let mut checked = 0;
+    for start in lod.branch_starts.iter().filter(|s| s.parent.is_some()) {
+        for k in 0..=start.sides {
+            let p = Vec3::from(lod.branches.positions[(start.first_vertex + k) as usize]);
+            let (distance, radius) = parent_tube(skeleton, start, tip_taper, p);
+            assert!(
+                (distance - radius).abs() <= 0.05 * radius,
+                "branch at internode {}: ring vertex {k} is {distance} from the parent axis, radius {radius}",
+                start.node.0
+            );
+            checked += 1;
+        }
+    }
+    checked
 }

@@ -1,0 +1,222 @@
+//! Renders every species preset, grown for a number of years, into `docs/images/<name>.png`
+//! with a small z-buffered CPU rasterizer: perspective camera, bark and leaf textures (leaves
+//! alpha-tested), ambient light from the growth shadow grid times a Lambert sun term.
+//! Stands in for the app's offscreen renderer for the README pictures.
+//!
+//! `cargo run --release -p sylva-core --example render_presets [years] [out_dir]`
+
+use std::path::PathBuf;
+
+use glam::camera::rh::proj::opengl::perspective;
+use glam::camera::rh::view::look_at_mat4;
+use glam::{Mat4, Vec2, Vec3, Vec4Swizzles};
+use image::{Rgba, RgbaImage};
+use sylva_core::Tree;
+use sylva_core::geometry::textures::{bark_texture, leaf_texture};
+use sylva_core::geometry::{TreeMesh, build_tree_meshes};
+use sylva_core::species::Species;
+
+const WIDTH: u32 = 480;
+const HEIGHT: u32 = 600;
+const SEED: u64 = 11;
+
+/// Pixels of the image and their depths.
+struct Target {
+    color: RgbaImage,
+    depth: Vec<f32>,
+}
+
+/// A triangle's vertex after projection: pixel position, depth, and what is interpolated.
+#[derive(Clone, Copy)]
+struct ScreenVertex {
+    pixel: Vec2,
+    depth: f32,
+    uv: Vec2,
+    shade: f32,
+}
+
+fn sky(y: u32) -> Rgba<u8> {
+    let t = y as f32 / HEIGHT as f32;
+    let mix = |a: f32, b: f32| (a + (b - a) * t) as u8;
+    Rgba([mix(170.0, 228.0), mix(200.0, 232.0), mix(235.0, 220.0), 255])
+}
+
+/// Rasterises the first `num_indices` indices of `mesh`, sampling `texture` (alpha-tested when
+/// `alpha_test`), lit by ambient × (sky + sun).
+fn draw(
+    target: &mut Target,
+    mesh: &TreeMesh,
+    num_indices: usize,
+    texture: &RgbaImage,
+    alpha_test: bool,
+    clip_from_world: Mat4,
+) {
+    let sun = Vec3::new(0.4, 0.8, 0.45).normalize();
+    let project = |i: u32| -> Option<ScreenVertex> {
+        let i = i as usize;
+        let clip = clip_from_world * Vec3::from(mesh.positions[i]).extend(1.0);
+        if clip.w <= 1e-4 {
+            return None;
+        }
+        let ndc = clip.xyz() / clip.w;
+        let normal = Vec3::from(mesh.normals[i]);
+        let lambert = if alpha_test {
+            normal.dot(sun).abs()
+        } else {
+            normal.dot(sun).max(0.0)
+        };
+        Some(ScreenVertex {
+            pixel: Vec2::new(
+                (ndc.x * 0.5 + 0.5) * WIDTH as f32,
+                (0.5 - ndc.y * 0.5) * HEIGHT as f32,
+            ),
+            depth: ndc.z,
+            uv: Vec2::from(mesh.uvs[i]),
+            shade: mesh.ambient[i] * (0.45 + 0.75 * lambert) + 0.12,
+        })
+    };
+    for triangle in mesh.indices[..num_indices].chunks_exact(3) {
+        let (Some(a), Some(b), Some(c)) = (
+            project(triangle[0]),
+            project(triangle[1]),
+            project(triangle[2]),
+        ) else {
+            continue;
+        };
+        fill(target, [a, b, c], texture, alpha_test);
+    }
+}
+
+fn fill(target: &mut Target, [a, b, c]: [ScreenVertex; 3], texture: &RgbaImage, alpha_test: bool) {
+    let area = (b.pixel - a.pixel).perp_dot(c.pixel - a.pixel);
+    if area.abs() < 1e-8 {
+        return;
+    }
+    let lo = a.pixel.min(b.pixel).min(c.pixel).max(Vec2::ZERO).floor();
+    let hi = a
+        .pixel
+        .max(b.pixel)
+        .max(c.pixel)
+        .min(Vec2::new(WIDTH as f32 - 1.0, HEIGHT as f32 - 1.0))
+        .ceil();
+    let (tw, th) = (texture.width() as f32, texture.height() as f32);
+    for y in lo.y as u32..=hi.y.max(lo.y) as u32 {
+        for x in lo.x as u32..=hi.x.max(lo.x) as u32 {
+            let p = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
+            let wa = (b.pixel - p).perp_dot(c.pixel - p) / area;
+            let wb = (c.pixel - p).perp_dot(a.pixel - p) / area;
+            let wc = 1.0 - wa - wb;
+            if wa < 0.0 || wb < 0.0 || wc < 0.0 {
+                continue;
+            }
+            let depth = wa * a.depth + wb * b.depth + wc * c.depth;
+            let slot = (y * WIDTH + x) as usize;
+            if depth >= target.depth[slot] {
+                continue;
+            }
+            let uv = a.uv * wa + b.uv * wb + c.uv * wc;
+            let tx = ((uv.x.rem_euclid(1.0)) * tw) as u32 % texture.width();
+            let ty = ((uv.y.rem_euclid(1.0)) * th) as u32 % texture.height();
+            let texel = texture.get_pixel(tx, ty);
+            if alpha_test && texel[3] < 128 {
+                continue;
+            }
+            let shade = (wa * a.shade + wb * b.shade + wc * c.shade).clamp(0.0, 1.3);
+            let lit = |c: u8| (c as f32 * shade).min(255.0) as u8;
+            target.depth[slot] = depth;
+            target.color.put_pixel(
+                x,
+                y,
+                Rgba([lit(texel[0]), lit(texel[1]), lit(texel[2]), 255]),
+            );
+        }
+    }
+}
+
+fn render(
+    tree: &Tree,
+    out: &std::path::Path,
+) -> Result<(usize, usize), Box<dyn std::error::Error>> {
+    let meshes = build_tree_meshes(tree);
+    let (lo, hi) = meshes.bounds(0).ok_or("the tree has no geometry")?;
+    let center = (lo + hi) * 0.5;
+    let size = (hi - lo).max_element().max(0.5);
+    let fov = 35f32.to_radians();
+    let distance = 0.62 * size / (fov * 0.5).tan() + 0.5 * size;
+    let eye = center + Vec3::new(0.0, 0.18, 1.0).normalize() * distance;
+    let world_to_view = look_at_mat4(eye, center, Vec3::Y);
+    let clip_from_view = perspective(
+        fov,
+        WIDTH as f32 / HEIGHT as f32,
+        0.05 * distance,
+        4.0 * distance,
+    );
+    let clip_from_world = clip_from_view * world_to_view;
+    let mut target = Target {
+        color: RgbaImage::from_fn(WIDTH, HEIGHT, |_, y| sky(y)),
+        depth: vec![f32::INFINITY; (WIDTH * HEIGHT) as usize],
+    };
+    let lod = &meshes.lods[0];
+    let bark = bark_texture(meshes.colors.bark, 128);
+    let leaf = leaf_texture(meshes.colors.leaf, 128);
+    let fruit = RgbaImage::from_pixel(
+        1,
+        1,
+        Rgba(
+            meshes
+                .colors
+                .fruit
+                .map(|c| (c.sqrt() * 255.0) as u8)
+                .into_iter()
+                .chain([255])
+                .collect::<Vec<_>>()
+                .try_into()
+                .map_err(|_| "colour")?,
+        ),
+    );
+    draw(
+        &mut target,
+        &lod.branches,
+        lod.branches.indices.len(),
+        &bark,
+        false,
+        clip_from_world,
+    );
+    draw(
+        &mut target,
+        &meshes.leaves,
+        lod.num_leaf_indices,
+        &leaf,
+        true,
+        clip_from_world,
+    );
+    draw(
+        &mut target,
+        &meshes.fruit,
+        lod.num_fruit_indices,
+        &fruit,
+        false,
+        clip_from_world,
+    );
+    target.color.save(out)?;
+    Ok((tree.skeleton.len(), meshes.num_triangles(0)))
+}
+
+fn main() -> Result<(), Box<dyn std::error::Error>> {
+    let mut args = std::env::args().skip(1);
+    let years: f32 = args.next().and_then(|a| a.parse().ok()).unwrap_or(12.0);
+    let out_dir = PathBuf::from(args.next().unwrap_or_else(|| "docs/images".into()));
+    std::fs::create_dir_all(&out_dir)?;
+    for species in Species::presets() {
+        let name = species.name.clone();
+        let mut tree = Tree::new(species, SEED);
+        tree.grow_years(years);
+        let path = out_dir.join(format!("{name}.png"));
+        let (internodes, triangles) = render(&tree, &path)?;
+        println!(
+            "{}: {internodes} internodes, {triangles} triangles at {years} years",
+            path.display()
+        );
+    }
+    Ok(())
+}
