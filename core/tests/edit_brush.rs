@@ -284,6 +284,19 @@ fn the_depth_constraint_keeps_points_near_the_plane_through_the_base() {
         .expect("point");
     let added = stroke.emit(&mut tree);
     assert!(added > 10, "only {added} points");
+    // A resting brush keeps painting around where it rests.
+    let dab = stroke.emit_dab(&mut tree);
+    assert!(dab > 0, "a resting brush added no points");
+    let rest = Vec3::new(0.5, 1.5, 0.0);
+    let last: Vec<_> = tree
+        .environment
+        .attraction
+        .points
+        .iter()
+        .rev()
+        .take(dab)
+        .collect();
+    assert!(last.iter().all(|p| p.position.distance(rest) <= 0.6 + 1e-5));
     assert!(
         tree.environment
             .attraction

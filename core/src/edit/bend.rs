@@ -52,8 +52,8 @@ impl Default for BendSettings {
             prism_width_factor: 1.0,
             allow_stretching: true,
             max_steps: 60,
-            polish_sweeps: 4,
-            tolerance_m: 1e-7,
+            polish_sweeps: 1,
+            tolerance_m: 1e-4,
         }
     }
 }

@@ -160,6 +160,15 @@ impl BrushStroke {
         added
     }
 
+    /// Points in the ball under the brush where it rests now (the brush keeps painting while
+    /// the finger stays down without moving). Returns how many were added.
+    pub fn emit_dab(&self, tree: &mut Tree) -> usize {
+        match self.points.last() {
+            Some(&p) => self.fill_segment(tree, p, p, tree.species.internode_length_m),
+            None => 0,
+        }
+    }
+
     /// Emits the new part of the stroke and runs one brush-guided growth iteration.
     pub fn iterate(&mut self, tree: &mut Tree) -> IterationStats {
         self.emit(tree);

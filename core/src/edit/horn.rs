@@ -63,7 +63,7 @@ fn largest_eigenvector(mut a: [[f64; 4]; 4], hint: [f64; 4]) -> [f64; 4] {
             .flat_map(|p| ((p + 1)..4).map(move |q| (p, q)))
             .map(|(p, q)| a[p][q].abs())
             .sum();
-        if off <= 1e-15 * scale {
+        if off <= 1e-13 * scale {
             break;
         }
         for p in 0..3 {
