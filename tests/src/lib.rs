@@ -2,6 +2,8 @@
 
 use std::path::PathBuf;
 
+pub mod synthetic;
+
 /// The shared test data folder: `$SYLVA_DATA`, else `../shared/test-data` beside the checkout.
 ///
 /// Panics with a clear message when it is absent: data-driven tests fail loudly, never skip.

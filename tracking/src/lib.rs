@@ -42,3 +42,4 @@ pub use sequence::{FrameSource, SequenceError, SourceEvent, TumSequence};
 #[cfg(feature = "opencv")]
 pub use tracker::{Tracker, TrackerConfig, TrackerError};
 
+pub mod depth_mesh;
