@@ -29,6 +29,8 @@ mod query;
 mod validity;
 
 #[cfg(test)]
+mod proptests;
+#[cfg(test)]
 mod tests;
 
 pub use export::OcclusionMesh;
