@@ -54,11 +54,12 @@ impl History {
     /// Call before performing an operation on `tree`: remembers the state to return to and
     /// forgets the redo branch.
     pub fn record(&mut self, kind: OperationKind, tree: &Tree) {
+        self.push(kind, tree.clone());
+    }
+
+    fn push(&mut self, kind: OperationKind, before: Tree) {
         self.redo.clear();
-        self.undo.push(Snapshot {
-            kind,
-            tree: tree.clone(),
-        });
+        self.undo.push(Snapshot { kind, tree: before });
         if self.max_operations > 0 && self.undo.len() > self.max_operations {
             self.undo.remove(0);
         }
@@ -75,7 +76,7 @@ impl History {
         let before = tree.clone();
         match operation(tree) {
             Ok(value) => {
-                self.record(kind, &before);
+                self.push(kind, before);
                 Ok(value)
             }
             Err(e) => {
