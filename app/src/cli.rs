@@ -15,6 +15,10 @@ pub enum Command {
     Species,
     /// Grows a tree autonomously and saves it; ends with a key=value summary line.
     Grow(crate::cmd_grow::GrowArgs),
+    /// Replays a recorded session headlessly: composited PNG frames and the final tree in --out.
+    Replay(crate::cmd_app::ReplayArgs),
+    /// Opens a window on a recorded sequence (or `--camera N`).
+    View(crate::cmd_app::ViewArgs),
 }
 
 pub fn main() -> anyhow::Result<()> {
@@ -22,6 +26,8 @@ pub fn main() -> anyhow::Result<()> {
     match cli.command {
         Some(Command::Species) => crate::cmd_grow::species(),
         Some(Command::Grow(args)) => crate::cmd_grow::grow(args),
-        None => Ok(()),
+        Some(Command::Replay(args)) => crate::cmd_app::replay_command(args),
+        Some(Command::View(args)) => crate::cmd_app::view(args),
+        None => crate::cmd_app::demo(),
     }
 }

@@ -5,3 +5,14 @@
 
 pub mod cli;
 pub mod cmd_grow;
+pub mod render;
+pub mod standin;
+pub mod tree_model;
+pub mod footage;
+pub mod state;
+pub mod session;
+pub mod ui;
+pub mod desktop;
+pub mod player;
+pub mod cmd_app;
+pub mod demo_script;

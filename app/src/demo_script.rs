@@ -1,0 +1,127 @@
+//! The scripted demo session on the bundled sequence: two brush strokes, a prune (double tap) and
+//! a bend (three touches), aimed at the tree as it is when each gesture happens. It is both the
+//! headless demo and the committed session that CI replays.
+
+use std::path::PathBuf;
+
+use glam::Vec2;
+
+use crate::footage::Footage;
+use crate::player::DEFAULT_SEED;
+use crate::session::{Session, frame_camera, frame_dt};
+use crate::state::{DesignState, InputEvent, Parameters, TouchPhase};
+
+fn touch(phase: TouchPhase, id: u64, p: Vec2) -> InputEvent {
+    InputEvent::Touch {
+        phase,
+        id,
+        x: p.x,
+        y: p.y,
+    }
+}
+
+/// Builds the demo session over every frame of `footage` (referenced as `footage_ref`).
+pub fn demo_session(footage: &Footage, footage_ref: PathBuf) -> anyhow::Result<Session> {
+    let params = Parameters::default();
+    let mut session = Session::new(footage_ref, DEFAULT_SEED, params.clone());
+    let mut state = DesignState::new(DEFAULT_SEED, params.clone());
+    let mut previous_time = footage.frames.first().map_or(0.0, |f| f.time_s);
+    let n = footage.len();
+    let at = |fraction: f32| (fraction * n as f32) as usize;
+    let mut stroke_pixel = Vec2::ZERO;
+    let mut bend_pixel = Vec2::ZERO;
+    for index in 0..n {
+        let step = index;
+        let mut events = Vec::new();
+        let top_pixel = state.camera.and_then(|c| {
+            let top = state
+                .tree
+                .internodes
+                .iter()
+                .map(|i| i.end)
+                .fold(glam::Vec3::ZERO, |a, b| if b.y > a.y { b } else { a });
+            c.pixel_from_world(top)
+        });
+        // Stroke 1: from the top of the seedling, up and to the right.
+        if step == at(0.1) {
+            if let Some(p) = top_pixel {
+                stroke_pixel = p;
+                events.push(touch(TouchPhase::Start, 0, p));
+            }
+        } else if step > at(0.1) && step < at(0.3) {
+            stroke_pixel += Vec2::new(1.5, -2.5);
+            events.push(touch(TouchPhase::Move, 0, stroke_pixel));
+        } else if step == at(0.3) {
+            events.push(touch(TouchPhase::End, 0, stroke_pixel));
+        }
+        // Stroke 2: from the top again, up and to the left, with a wider brush half way.
+        if step == at(0.35)
+            && let Some(p) = top_pixel
+        {
+            stroke_pixel = p;
+            events.push(touch(TouchPhase::Start, 0, p));
+        } else if step > at(0.35) && step < at(0.55) {
+            stroke_pixel += Vec2::new(-2.0, -2.0);
+            events.push(touch(TouchPhase::Move, 0, stroke_pixel));
+            if step == at(0.45) {
+                let mut p = state.params.clone();
+                p.brush_radius *= 1.6;
+                events.push(InputEvent::Parameters { parameters: p });
+            }
+        } else if step == at(0.55) {
+            events.push(touch(TouchPhase::End, 0, stroke_pixel));
+        }
+        // Prune: double tap on the newest branch.
+        if (step == at(0.62) || step == at(0.62) + 1)
+            && let (Some(camera), Some(newest)) = (state.camera, state.tree.internodes.last())
+            && let Some(p) = camera.pixel_from_world(0.5 * (newest.start + newest.end))
+        {
+            events.push(touch(TouchPhase::Start, 0, p));
+            events.push(touch(TouchPhase::End, 0, p));
+        }
+        // Bend: three fingers around a branch half way up, dragged to the right.
+        if step == at(0.7)
+            && let Some(camera) = state.camera
+            && let Some(node) = state.tree.internodes.get(state.tree.len() / 2)
+            && let Some(p) = camera.pixel_from_world(node.end)
+        {
+            bend_pixel = p;
+            for (id, offset) in [
+                (1, Vec2::new(-10.0, 0.0)),
+                (2, Vec2::new(10.0, 0.0)),
+                (3, Vec2::new(0.0, 10.0)),
+            ] {
+                events.push(touch(TouchPhase::Start, id, p + offset));
+            }
+        } else if step > at(0.7) && step < at(0.8) {
+            bend_pixel.x += 3.0;
+            for (id, offset) in [
+                (1, Vec2::new(-10.0, 0.0)),
+                (2, Vec2::new(10.0, 0.0)),
+                (3, Vec2::new(0.0, 10.0)),
+            ] {
+                events.push(touch(TouchPhase::Move, id, bend_pixel + offset));
+            }
+        } else if step == at(0.8) {
+            for id in 1..=3 {
+                events.push(touch(TouchPhase::End, id, bend_pixel));
+            }
+        }
+        for e in events {
+            state.apply(&e);
+            session.record(e);
+        }
+        session.push_frame(footage, index);
+        let Some(record) = session.frames.last() else {
+            continue;
+        };
+        let camera = frame_camera(record, footage);
+        state.advance_frame(
+            camera,
+            record.time_s,
+            frame_dt(record.time_s - previous_time),
+        );
+        previous_time = record.time_s;
+    }
+    Ok(session)
+}

@@ -1,0 +1,135 @@
+//! Plays footage into the design state and records the session: shared by the window and the
+//! headless demo.
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Context;
+use glam::Vec3;
+use image::RgbaImage;
+
+use crate::footage::Footage;
+use crate::render::{GroundPlane, ViewCamera};
+use crate::session::{Session, frame_dt};
+use crate::state::{DesignState, InputEvent, Parameters};
+use crate::ui::UiState;
+
+/// Seed of trees planted by the app.
+pub const DEFAULT_SEED: u64 = 7;
+/// Updates with a pose before the seedling is planted (coaching overlay shown).
+const FRAMES_TO_FIND_GROUND: usize = 15;
+
+/// Footage playback, the design and the session being recorded.
+pub struct Player {
+    pub footage: Footage,
+    pub design: DesignState,
+    pub ui: UiState,
+    pub session: Session,
+    pub frame: usize,
+    pub image: Option<RgbaImage>,
+    pub depth: Option<(u32, u32, Vec<f32>)>,
+    last_tick_s: Option<f64>,
+    frame_clock_s: f64,
+    ticks_with_pose: usize,
+}
+
+impl Player {
+    pub fn new(footage: Footage, footage_ref: PathBuf) -> Player {
+        let params = Parameters::default();
+        let ui = UiState {
+            num_frames: footage.len(),
+            ..UiState::default()
+        };
+        Player {
+            session: Session::new(footage_ref, DEFAULT_SEED, params.clone()),
+            design: DesignState::new(DEFAULT_SEED, params),
+            footage,
+            ui,
+            frame: 0,
+            image: None,
+            depth: None,
+            last_tick_s: None,
+            frame_clock_s: 0.0,
+            ticks_with_pose: 0,
+        }
+    }
+
+    /// The camera of the current frame.
+    pub fn camera(&self) -> Option<ViewCamera> {
+        let m = self.footage.frames.get(self.frame)?.world_from_camera?;
+        Some(ViewCamera::new(self.footage.intrinsics, m))
+    }
+
+    /// The ground plane once found (the coaching overlay shows until then).
+    pub fn ground(&self) -> Option<GroundPlane> {
+        self.ui.ground_found.then(GroundPlane::default)
+    }
+
+    /// The brush sphere at the finger while painting.
+    pub fn brush_sphere(&self) -> Option<(Vec3, f32)> {
+        let stroke = self.design.stroke.as_ref()?;
+        Some((*stroke.points.last()?, self.design.params.brush_radius))
+    }
+
+    /// Applies and records an input event.
+    pub fn input(&mut self, event: InputEvent) {
+        self.session.record(event.clone());
+        self.design.apply(&event);
+    }
+
+    /// Shows footage frame `index` and advances the design to it.
+    pub fn show_frame(&mut self, index: usize) -> anyhow::Result<()> {
+        let index = index.min(self.footage.len().saturating_sub(1));
+        let previous_time = self
+            .footage
+            .frames
+            .get(self.frame)
+            .map_or(0.0, |f| f.time_s);
+        self.frame = index;
+        self.ui.frame = index;
+        self.image = Some(self.footage.load_rgba(index)?);
+        self.depth = self.footage.load_depth_m(index)?;
+        self.session.push_frame(&self.footage, index);
+        let time_s = self.footage.frames[index].time_s;
+        let started = std::time::Instant::now();
+        self.design
+            .advance_frame(self.camera(), time_s, frame_dt(time_s - previous_time));
+        self.ui.budget.growth_ms = started.elapsed().as_secs_f32() * 1000.0;
+        Ok(())
+    }
+
+    /// Advances playback to wall-clock `now_s` (30 Hz footage, looping), honouring pause/seek.
+    pub fn tick(&mut self, now_s: f64) -> anyhow::Result<()> {
+        // TEMPORARY STAND-IN for the tracker's plane detection: the ground counts as found after
+        // a short run of updates with a camera pose.
+        if self.camera().is_some() {
+            self.ticks_with_pose += 1;
+        }
+        self.ui.ground_found |= self.ticks_with_pose >= FRAMES_TO_FIND_GROUND;
+        if let Some(target) = self.ui.seek_to.take() {
+            return self.show_frame(target);
+        }
+        let last = self.last_tick_s.replace(now_s);
+        if self.image.is_none() {
+            return self.show_frame(self.frame);
+        }
+        if !self.ui.playing {
+            return Ok(());
+        }
+        self.frame_clock_s += now_s - last.unwrap_or(now_s);
+        if self.frame_clock_s >= 1.0 / 30.0 {
+            self.frame_clock_s = 0.0;
+            let next = (self.frame + 1) % self.footage.len().max(1);
+            self.show_frame(next)?;
+        }
+        Ok(())
+    }
+}
+
+/// Writes the tree as `tree.json` (and `.glb` once glTF export is available) into `dir`.
+pub fn export_tree(design: &DesignState, dir: &Path) -> anyhow::Result<PathBuf> {
+    std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
+    let path = dir.join("tree.json");
+    std::fs::write(&path, serde_json::to_vec_pretty(&design.tree)?)
+        .with_context(|| format!("cannot write {}", path.display()))?;
+    Ok(path)
+}

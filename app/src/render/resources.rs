@@ -1,0 +1,581 @@
+//! The renderer's GPU resources and the frame it records.
+
+use bytemuck::{Pod, Zeroable};
+use glam::{Mat4, Vec3, Vec4};
+
+use wgpu::util::DeviceExt;
+
+use crate::render::camera::Intrinsics;
+use crate::render::mesh::{LitMesh, OccluderMesh, TreeMesh};
+use crate::render::pipelines::{DEPTH_FORMAT, Pipelines, SAMPLE_COUNT};
+use crate::render::{FrameView, Gpu, GroundStyle};
+
+/// Side of the square shadow map, texels.
+const SHADOW_MAP_SIZE: u32 = 2048;
+const BRUSH_VERTICES: u32 = 12 * 24 * 6;
+
+/// Mirrors `Globals` in scene.wgsl.
+#[repr(C)]
+#[derive(Clone, Copy, Pod, Zeroable)]
+struct Globals {
+    clip_from_world: [[f32; 4]; 4],
+    light_clip_from_world: [[f32; 4]; 4],
+    sun_direction: [f32; 4],
+    sun_color: [f32; 4],
+    ground_origin: [f32; 4],
+    ground_u: [f32; 4],
+    ground_v: [f32; 4],
+    brush: [f32; 4],
+    intrinsics: [f32; 4],
+    distortion: [f32; 4],
+    image: [f32; 4],
+    viewport: [f32; 4],
+    misc: [f32; 4],
+}
+
+struct GpuMesh {
+    vertices: wgpu::Buffer,
+    indices: Option<wgpu::Buffer>,
+    count: u32,
+}
+
+struct Background {
+    texture: wgpu::Texture,
+    intrinsics: Intrinsics,
+}
+
+/// Owns pipelines, uploaded meshes and images, and draws frames into any colour target of the
+/// format it was made for.
+pub struct Renderer {
+    pipelines: Pipelines,
+    globals: wgpu::Buffer,
+    shadow_view: wgpu::TextureView,
+    shadow_sampler: wgpu::Sampler,
+    linear_sampler: wgpu::Sampler,
+    background: Background,
+    has_camera_image: bool,
+    scene_group: wgpu::BindGroup,
+    shadow_group: wgpu::BindGroup,
+    branches: Option<GpuMesh>,
+    leaves: Option<GpuMesh>,
+    tree_bounds: Option<(Vec3, Vec3)>,
+    occluder: Option<GpuMesh>,
+    wireframe: Option<GpuMesh>,
+    points: Option<GpuMesh>,
+    /// MSAA colour and depth targets, with their size.
+    targets: Option<((u32, u32), wgpu::TextureView, wgpu::TextureView)>,
+    color_format: wgpu::TextureFormat,
+}
+
+fn texture_2d(
+    device: &wgpu::Device,
+    label: &str,
+    (width, height): (u32, u32),
+    format: wgpu::TextureFormat,
+    sample_count: u32,
+    usage: wgpu::TextureUsages,
+) -> wgpu::Texture {
+    device.create_texture(&wgpu::TextureDescriptor {
+        label: Some(label),
+        size: wgpu::Extent3d {
+            width,
+            height,
+            depth_or_array_layers: 1,
+        },
+        mip_level_count: 1,
+        sample_count,
+        dimension: wgpu::TextureDimension::D2,
+        format,
+        usage,
+        view_formats: &[],
+    })
+}
+
+impl Renderer {
+    /// A renderer drawing into targets of `color_format`.
+    pub fn new(gpu: &Gpu, color_format: wgpu::TextureFormat) -> Renderer {
+        let device = &gpu.device;
+        let pipelines = Pipelines::new(device, color_format);
+        let globals = device.create_buffer(&wgpu::BufferDescriptor {
+            label: Some("sylva globals"),
+            size: std::mem::size_of::<Globals>() as u64,
+            usage: wgpu::BufferUsages::UNIFORM | wgpu::BufferUsages::COPY_DST,
+            mapped_at_creation: false,
+        });
+        let shadow = texture_2d(
+            device,
+            "sun shadow map",
+            (SHADOW_MAP_SIZE, SHADOW_MAP_SIZE),
+            DEPTH_FORMAT,
+            1,
+            wgpu::TextureUsages::RENDER_ATTACHMENT | wgpu::TextureUsages::TEXTURE_BINDING,
+        );
+        let shadow_view = shadow.create_view(&Default::default());
+        let shadow_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("shadow comparison"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            compare: Some(wgpu::CompareFunction::LessEqual),
+            ..Default::default()
+        });
+        let linear_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("camera image"),
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            ..Default::default()
+        });
+        let background = Background {
+            texture: background_texture(device, (1, 1)),
+            intrinsics: Intrinsics::from_fov(1, 1, 1.0),
+        };
+        let shadow_group = device.create_bind_group(&wgpu::BindGroupDescriptor {
+            label: Some("shadow globals"),
+            layout: &pipelines.shadow_layout,
+            entries: &[wgpu::BindGroupEntry {
+                binding: 0,
+                resource: globals.as_entire_binding(),
+            }],
+        });
+        let scene_group = scene_group(
+            device,
+            &pipelines,
+            &globals,
+            &shadow_view,
+            &shadow_sampler,
+            &background.texture,
+            &linear_sampler,
+        );
+        Renderer {
+            pipelines,
+            globals,
+            shadow_view,
+            shadow_sampler,
+            linear_sampler,
+            background,
+            has_camera_image: false,
+            scene_group,
+            shadow_group,
+            branches: None,
+            leaves: None,
+            tree_bounds: None,
+            occluder: None,
+            wireframe: None,
+            points: None,
+            targets: None,
+            color_format,
+        }
+    }
+
+    pub fn color_format(&self) -> wgpu::TextureFormat {
+        self.color_format
+    }
+
+    /// Uploads the tree (replacing the previous one).
+    pub fn set_tree(&mut self, gpu: &Gpu, tree: &TreeMesh) {
+        self.branches = upload_lit(&gpu.device, &tree.branches);
+        self.leaves = upload_lit(&gpu.device, &tree.leaves);
+        self.tree_bounds = tree.bounds();
+    }
+
+    /// Uploads the scene's depth mesh (occluder and wireframe).
+    pub fn set_occluder(&mut self, gpu: &Gpu, mesh: &OccluderMesh) {
+        let positions: Vec<[f32; 3]> = mesh.positions.iter().map(|p| p.to_array()).collect();
+        self.occluder = upload(&gpu.device, &positions, Some(&mesh.indices));
+        self.wireframe = upload(&gpu.device, &mesh.wireframe(), None);
+    }
+
+    /// Uploads the tracked feature points (world space) for the debug view.
+    pub fn set_feature_points(&mut self, gpu: &Gpu, points: &[Vec3]) {
+        let positions: Vec<[f32; 3]> = points.iter().map(|p| p.to_array()).collect();
+        self.points = upload(&gpu.device, &positions, None);
+    }
+
+    /// Uploads a camera image (tightly packed RGBA8, sRGB) taken with `intrinsics`.
+    pub fn set_camera_image(&mut self, gpu: &Gpu, rgba: &[u8], intrinsics: Intrinsics) {
+        let size = (intrinsics.width, intrinsics.height);
+        if rgba.len() != (size.0 * size.1 * 4) as usize {
+            self.has_camera_image = false;
+            return;
+        }
+        let current = self.background.texture.size();
+        if (current.width, current.height) != size {
+            self.background.texture = background_texture(&gpu.device, size);
+            self.scene_group = scene_group(
+                &gpu.device,
+                &self.pipelines,
+                &self.globals,
+                &self.shadow_view,
+                &self.shadow_sampler,
+                &self.background.texture,
+                &self.linear_sampler,
+            );
+        }
+        gpu.queue.write_texture(
+            self.background.texture.as_image_copy(),
+            rgba,
+            wgpu::TexelCopyBufferLayout {
+                offset: 0,
+                bytes_per_row: Some(size.0 * 4),
+                rows_per_image: Some(size.1),
+            },
+            self.background.texture.size(),
+        );
+        self.background.intrinsics = intrinsics;
+        self.has_camera_image = true;
+    }
+
+    fn ensure_targets(&mut self, device: &wgpu::Device, size: (u32, u32)) {
+        if self.targets.as_ref().is_some_and(|(s, _, _)| *s == size) {
+            return;
+        }
+        let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
+        let color = texture_2d(
+            device,
+            "msaa colour",
+            size,
+            self.color_format,
+            SAMPLE_COUNT,
+            usage,
+        );
+        let depth = texture_2d(
+            device,
+            "msaa depth",
+            size,
+            DEPTH_FORMAT,
+            SAMPLE_COUNT,
+            usage,
+        );
+        self.targets = Some((
+            size,
+            color.create_view(&Default::default()),
+            depth.create_view(&Default::default()),
+        ));
+    }
+
+    /// Records one frame into `target` (of `size` pixels, this renderer's colour format).
+    pub fn render(
+        &mut self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &wgpu::TextureView,
+        size: (u32, u32),
+        view: &FrameView,
+    ) {
+        self.ensure_targets(&gpu.device, size);
+        let region = letterbox(size, &view.camera.intrinsics);
+        let globals = self.globals_for(view, region);
+        gpu.queue
+            .write_buffer(&self.globals, 0, bytemuck::bytes_of(&globals));
+        self.shadow_pass(encoder);
+        let Some((_, msaa_color, msaa_depth)) = &self.targets else {
+            return;
+        };
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("scene"),
+            color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                view: msaa_color,
+                depth_slice: None,
+                resolve_target: Some(target),
+                ops: wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
+                    store: wgpu::StoreOp::Discard,
+                },
+            })],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: msaa_depth,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Discard,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_viewport(region[0], region[1], region[2], region[3], 0.0, 1.0);
+        pass.set_bind_group(0, &self.scene_group, &[]);
+        let p = &self.pipelines;
+        pass.set_pipeline(&p.background);
+        pass.draw(0..3, 0..1);
+        if view.occlude {
+            draw(&mut pass, &p.occluder, self.occluder.as_ref());
+        }
+        if view.ground.is_some() && self.tree_bounds.is_some() {
+            pass.set_pipeline(match view.ground_style {
+                GroundStyle::ShadowCatcher => &p.ground_shadow,
+                GroundStyle::Lawn => &p.ground_lawn,
+            });
+            pass.draw(0..6, 0..1);
+        }
+        draw(&mut pass, &p.branches, self.branches.as_ref());
+        draw(&mut pass, &p.leaves, self.leaves.as_ref());
+        if view.debug.depth_wireframe {
+            draw(&mut pass, &p.wire, self.wireframe.as_ref());
+        }
+        if view.debug.feature_points
+            && let Some(points) = &self.points
+        {
+            pass.set_pipeline(&p.points);
+            pass.set_vertex_buffer(0, points.vertices.slice(..));
+            pass.draw(0..6, 0..points.count);
+        }
+        if view.debug.brush.is_some() {
+            pass.set_pipeline(&p.brush);
+            pass.draw(0..BRUSH_VERTICES, 0..1);
+        }
+    }
+
+    fn shadow_pass(&self, encoder: &mut wgpu::CommandEncoder) {
+        let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            label: Some("sun shadow map"),
+            color_attachments: &[],
+            depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
+                view: &self.shadow_view,
+                depth_ops: Some(wgpu::Operations {
+                    load: wgpu::LoadOp::Clear(1.0),
+                    store: wgpu::StoreOp::Store,
+                }),
+                stencil_ops: None,
+            }),
+            timestamp_writes: None,
+            occlusion_query_set: None,
+            multiview_mask: None,
+        });
+        pass.set_bind_group(0, &self.shadow_group, &[]);
+        draw(
+            &mut pass,
+            &self.pipelines.shadow_branches,
+            self.branches.as_ref(),
+        );
+        draw(
+            &mut pass,
+            &self.pipelines.shadow_leaves,
+            self.leaves.as_ref(),
+        );
+    }
+
+    fn globals_for(&self, view: &FrameView, region: [f32; 4]) -> Globals {
+        let camera = crate::render::ViewCamera {
+            intrinsics: view
+                .camera
+                .intrinsics
+                .scaled_to(region[2].round() as u32, region[3].round() as u32),
+            ..view.camera
+        };
+        let light = &view.lighting;
+        let sun = light.sun_direction.try_normalize().unwrap_or(Vec3::Y);
+        let (centre, radius) = match self.tree_bounds {
+            Some((lo, hi)) => (0.5 * (lo + hi), (0.5 * (hi - lo)).length().max(0.05)),
+            None => (Vec3::ZERO, 1.0),
+        };
+        let light_clip_from_world = sun_clip_from_world(sun, centre, radius);
+        let ground = view.ground.unwrap_or_default();
+        let normal = ground.normal.try_normalize().unwrap_or(Vec3::Y);
+        let u = normal.any_orthonormal_vector();
+        let v = u.cross(normal);
+        // The ground quad is centred under the tree and reaches well past its shadow.
+        let origin = centre - normal * normal.dot(centre - ground.point);
+        let extent = radius * 3.0;
+        let k = &self.background.intrinsics;
+        let (brush, brush_radius) = view.debug.brush.unwrap_or((Vec3::ZERO, 0.0));
+        let show_image = view.show_camera_image && self.has_camera_image;
+        let texel = 1.0 / SHADOW_MAP_SIZE as f32;
+        Globals {
+            clip_from_world: camera.clip_from_world().to_cols_array_2d(),
+            light_clip_from_world: light_clip_from_world.to_cols_array_2d(),
+            sun_direction: sun.extend(light.sun_strength).to_array(),
+            sun_color: [1.0, 0.96, 0.88, light.ambient_strength],
+            ground_origin: origin.extend(extent).to_array(),
+            ground_u: u.extend(0.0).to_array(),
+            ground_v: v.extend(light.shadow_strength).to_array(),
+            brush: brush.extend(brush_radius).to_array(),
+            intrinsics: [k.fx, k.fy, k.cx, k.cy],
+            distortion: [
+                k.distortion[0],
+                k.distortion[1],
+                k.distortion[2],
+                k.distortion[3],
+            ],
+            image: [
+                k.distortion[4],
+                k.width as f32,
+                k.height as f32,
+                if show_image { 1.0 } else { 0.0 },
+            ],
+            viewport: region,
+            misc: [3.0, texel, 1.5, 0.0],
+        }
+    }
+}
+
+/// Orthographic view of the tree's bounding sphere from the sun (depth 0..1).
+fn sun_clip_from_world(sun: Vec3, centre: Vec3, radius: f32) -> Mat4 {
+    let eye = centre + sun * radius * 2.0;
+    let up = if sun.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
+    let view = light_from_world(eye, centre, up);
+    let r = radius * 1.05;
+    orthographic(r, radius * 0.5, radius * 4.0) * view
+}
+
+/// Right-handed view (looking down −Z) from `eye` towards `target`.
+fn light_from_world(eye: Vec3, target: Vec3, up: Vec3) -> Mat4 {
+    let f = (target - eye).normalize_or(Vec3::NEG_Y);
+    let s = f.cross(up).normalize_or(Vec3::X);
+    let u = s.cross(f);
+    Mat4::from_cols(
+        Vec4::new(s.x, u.x, -f.x, 0.0),
+        Vec4::new(s.y, u.y, -f.y, 0.0),
+        Vec4::new(s.z, u.z, -f.z, 0.0),
+        Vec4::new(-s.dot(eye), -u.dot(eye), f.dot(eye), 1.0),
+    )
+}
+
+/// Orthographic projection of the box |x|, |y| ≤ `half` between `near` and `far` in front of
+/// the view, to wgpu clip space (depth 0..1).
+fn orthographic(half: f32, near: f32, far: f32) -> Mat4 {
+    let depth = 1.0 / (near - far);
+    Mat4::from_cols(
+        Vec4::new(1.0 / half, 0.0, 0.0, 0.0),
+        Vec4::new(0.0, 1.0 / half, 0.0, 0.0),
+        Vec4::new(0.0, 0.0, depth, 0.0),
+        Vec4::new(0.0, 0.0, depth * near, 1.0),
+    )
+}
+
+/// The largest region of the target with the camera image's aspect, centred: x, y, w, h.
+pub fn letterbox(size: (u32, u32), k: &Intrinsics) -> [f32; 4] {
+    let (tw, th) = (size.0 as f32, size.1 as f32);
+    let aspect = k.width as f32 / k.height.max(1) as f32;
+    let (w, h) = if tw / th > aspect {
+        (th * aspect, th)
+    } else {
+        (tw, tw / aspect)
+    };
+    let (w, h) = (w.round().max(1.0), h.round().max(1.0));
+    [((tw - w) * 0.5).round(), ((th - h) * 0.5).round(), w, h]
+}
+
+fn draw(pass: &mut wgpu::RenderPass<'_>, pipeline: &wgpu::RenderPipeline, mesh: Option<&GpuMesh>) {
+    let Some(mesh) = mesh else {
+        return;
+    };
+    pass.set_pipeline(pipeline);
+    pass.set_vertex_buffer(0, mesh.vertices.slice(..));
+    match &mesh.indices {
+        Some(indices) => {
+            pass.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);
+            pass.draw_indexed(0..mesh.count, 0, 0..1);
+        }
+        None => pass.draw(0..mesh.count, 0..1),
+    }
+}
+
+fn upload_lit(device: &wgpu::Device, mesh: &LitMesh) -> Option<GpuMesh> {
+    upload(device, &mesh.vertices, Some(&mesh.indices))
+}
+
+fn upload<T: Pod>(
+    device: &wgpu::Device,
+    vertices: &[T],
+    indices: Option<&[u32]>,
+) -> Option<GpuMesh> {
+    if vertices.is_empty() || indices.is_some_and(|i| i.is_empty()) {
+        return None;
+    }
+    let vertex_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+        label: None,
+        contents: bytemuck::cast_slice(vertices),
+        usage: wgpu::BufferUsages::VERTEX,
+    });
+    let index_buffer = indices.map(|indices| {
+        device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
+            label: None,
+            contents: bytemuck::cast_slice(indices),
+            usage: wgpu::BufferUsages::INDEX,
+        })
+    });
+    Some(GpuMesh {
+        vertices: vertex_buffer,
+        count: indices.map_or(vertices.len(), |i| i.len()) as u32,
+        indices: index_buffer,
+    })
+}
+
+fn background_texture(device: &wgpu::Device, size: (u32, u32)) -> wgpu::Texture {
+    texture_2d(
+        device,
+        "camera image",
+        size,
+        wgpu::TextureFormat::Rgba8UnormSrgb,
+        1,
+        wgpu::TextureUsages::TEXTURE_BINDING | wgpu::TextureUsages::COPY_DST,
+    )
+}
+
+fn scene_group(
+    device: &wgpu::Device,
+    pipelines: &Pipelines,
+    globals: &wgpu::Buffer,
+    shadow_view: &wgpu::TextureView,
+    shadow_sampler: &wgpu::Sampler,
+    background: &wgpu::Texture,
+    linear_sampler: &wgpu::Sampler,
+) -> wgpu::BindGroup {
+    let background_view = background.create_view(&Default::default());
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("scene globals"),
+        layout: &pipelines.scene_layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: globals.as_entire_binding(),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: wgpu::BindingResource::TextureView(shadow_view),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: wgpu::BindingResource::Sampler(shadow_sampler),
+            },
+            wgpu::BindGroupEntry {
+                binding: 3,
+                resource: wgpu::BindingResource::TextureView(&background_view),
+            },
+            wgpu::BindGroupEntry {
+                binding: 4,
+                resource: wgpu::BindingResource::Sampler(linear_sampler),
+            },
+        ],
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn letterbox_keeps_the_image_aspect_and_centres_it() {
+        let k = Intrinsics::from_fov(640, 480, 1.0);
+        assert_eq!(letterbox((640, 480), &k), [0.0, 0.0, 640.0, 480.0]);
+        assert_eq!(letterbox((1000, 480), &k), [180.0, 0.0, 640.0, 480.0]);
+    }
+
+    #[test]
+    fn the_sun_view_contains_the_tree_bounds() {
+        let m = sun_clip_from_world(Vec3::new(0.3, 0.9, 0.2).normalize(), Vec3::Y, 1.0);
+        for p in [
+            Vec3::ZERO,
+            Vec3::new(0.0, 2.0, 0.0),
+            Vec3::new(0.6, 1.0, -0.6),
+        ] {
+            let c = m * Vec4::from((p, 1.0));
+            let n = c.truncate() / c.w;
+            assert!(
+                n.x.abs() <= 1.0 && n.y.abs() <= 1.0 && (0.0..=1.0).contains(&n.z),
+                "{p} -> {n}"
+            );
+        }
+    }
+}

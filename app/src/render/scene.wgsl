@@ -1,0 +1,300 @@
+// Sylva's scene shader: every pipeline of the renderer shares this module and bind group 0.
+// World space: metres, Y up. Clip space: wgpu (depth 0..1).
+
+struct Globals {
+    clip_from_world: mat4x4<f32>,
+    light_clip_from_world: mat4x4<f32>,
+    // xyz: unit direction towards the sun; w: sun strength.
+    sun_direction: vec4<f32>,
+    // rgb: sun colour; w: ambient (sky) strength.
+    sun_color: vec4<f32>,
+    // xyz: ground centre (under the tree); w: half extent of the ground quad, metres.
+    ground_origin: vec4<f32>,
+    // xyz: first in-plane axis; w: unused.
+    ground_u: vec4<f32>,
+    // xyz: second in-plane axis; w: shadow strength on the real ground (0..1).
+    ground_v: vec4<f32>,
+    // xyz: brush centre; w: radius, metres.
+    brush: vec4<f32>,
+    // Background image: fx, fy, cx, cy (pixels of the image).
+    intrinsics: vec4<f32>,
+    // k1, k2, p1, p2.
+    distortion: vec4<f32>,
+    // k3, image width, image height, 1 when a camera image is shown.
+    image: vec4<f32>,
+    // Drawn region of the target, pixels: x0, y0, width, height.
+    viewport: vec4<f32>,
+    // point size (px), shadow map texel size (uv), PCF spacing (texels), unused.
+    misc: vec4<f32>,
+}
+
+@group(0) @binding(0) var<uniform> g: Globals;
+@group(0) @binding(1) var shadow_map: texture_depth_2d;
+@group(0) @binding(2) var shadow_sampler: sampler_comparison;
+@group(0) @binding(3) var background: texture_2d<f32>;
+@group(0) @binding(4) var linear_sampler: sampler;
+
+const BARK: vec3<f32> = vec3<f32>(0.30, 0.21, 0.14);
+const LEAF: vec3<f32> = vec3<f32>(0.16, 0.38, 0.09);
+const LAWN: vec3<f32> = vec3<f32>(0.22, 0.42, 0.16);
+const SKY: vec3<f32> = vec3<f32>(0.72, 0.82, 1.0);
+
+// Fraction of the sun visible from a point, percentage-closer filtered over a 5 x 5 footprint
+// (each tap is itself a bilinear 2 x 2 comparison): a soft edge.
+fn sun_visibility(world: vec3<f32>, normal: vec3<f32>) -> f32 {
+    let lc = g.light_clip_from_world * vec4<f32>(world + normal * 0.01, 1.0);
+    let ndc = lc.xyz / lc.w;
+    let uv = vec2<f32>(ndc.x * 0.5 + 0.5, 0.5 - ndc.y * 0.5);
+    if (uv.x < 0.0 || uv.x > 1.0 || uv.y < 0.0 || uv.y > 1.0 || ndc.z > 1.0) {
+        return 1.0;
+    }
+    let step = g.misc.y * g.misc.z;
+    var sum = 0.0;
+    for (var i = -2; i <= 2; i++) {
+        for (var j = -2; j <= 2; j++) {
+            let offset = vec2<f32>(f32(i), f32(j)) * step;
+            sum += textureSampleCompareLevel(shadow_map, shadow_sampler, uv + offset, ndc.z - 0.003);
+        }
+    }
+    return sum / 25.0;
+}
+
+fn shade(albedo: vec3<f32>, n: vec3<f32>, world: vec3<f32>, ambient: f32) -> vec3<f32> {
+    let l = g.sun_direction.xyz;
+    let direct = max(dot(n, l), 0.0) * sun_visibility(world, n) * g.sun_direction.w;
+    let sky = g.sun_color.w * ambient * (0.6 + 0.4 * max(n.y, 0.0));
+    return albedo * (sky * SKY + direct * g.sun_color.rgb);
+}
+
+// ---- lit tree surfaces ----
+
+struct LitIn {
+    @location(0) position: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) ambient: f32,
+    @location(3) uv: vec2<f32>,
+}
+
+struct LitOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) normal: vec3<f32>,
+    @location(2) ambient: f32,
+    @location(3) uv: vec2<f32>,
+}
+
+@vertex
+fn vs_lit(v: LitIn) -> LitOut {
+    var out: LitOut;
+    out.clip = g.clip_from_world * vec4<f32>(v.position, 1.0);
+    out.world = v.position;
+    out.normal = v.normal;
+    out.ambient = v.ambient;
+    out.uv = v.uv;
+    return out;
+}
+
+@fragment
+fn fs_branch(v: LitOut) -> @location(0) vec4<f32> {
+    let n = normalize(v.normal);
+    return vec4<f32>(shade(BARK, n, v.world, v.ambient), 1.0);
+}
+
+// Leaf blade: half width 0.5 sin(pi y)^0.7 along y in [0, 1]; the signed distance to the edge,
+// divided by its screen-space derivative, becomes coverage (alpha to coverage under MSAA).
+fn leaf_coverage(uv: vec2<f32>) -> f32 {
+    let y = clamp(uv.y, 0.0, 1.0);
+    let half_width = 0.5 * pow(sin(3.14159265 * y), 0.7);
+    let d = half_width - abs(uv.x);
+    return clamp(d / max(fwidth(d), 1e-5) + 0.5, 0.0, 1.0);
+}
+
+@fragment
+fn fs_leaf(v: LitOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
+    let alpha = leaf_coverage(v.uv);
+    var n = normalize(v.normal);
+    if (!front) {
+        n = -n;
+    }
+    let tint = LEAF * (0.85 + 0.3 * v.uv.y);
+    return vec4<f32>(shade(tint, n, v.world, v.ambient), alpha);
+}
+
+// ---- shadow map (depth only, from the sun) ----
+
+struct ShadowOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) uv: vec2<f32>,
+}
+
+@vertex
+fn vs_shadow(v: LitIn) -> ShadowOut {
+    var out: ShadowOut;
+    out.clip = g.light_clip_from_world * vec4<f32>(v.position, 1.0);
+    out.uv = v.uv;
+    return out;
+}
+
+@fragment
+fn fs_shadow_leaf(v: ShadowOut) {
+    let y = clamp(v.uv.y, 0.0, 1.0);
+    if (abs(v.uv.x) > 0.5 * pow(sin(3.14159265 * y), 0.7)) {
+        discard;
+    }
+}
+
+// ---- camera image background (undistorted for display) ----
+
+struct ScreenOut {
+    @builtin(position) clip: vec4<f32>,
+}
+
+@vertex
+fn vs_fullscreen(@builtin(vertex_index) i: u32) -> ScreenOut {
+    let xy = vec2<f32>(f32((i << 1u) & 2u), f32(i & 2u)) * 2.0 - 1.0;
+    var out: ScreenOut;
+    out.clip = vec4<f32>(xy, 0.0, 1.0);
+    return out;
+}
+
+@fragment
+fn fs_background(s: ScreenOut) -> @location(0) vec4<f32> {
+    let t = (s.clip.xy - g.viewport.xy) / g.viewport.zw;
+    if (g.image.w < 0.5) {
+        return vec4<f32>(mix(SKY, vec3<f32>(0.93, 0.95, 0.97), t.y), 1.0);
+    }
+    // The displayed image is the ideal pinhole view with the image's intrinsics: find where each
+    // displayed pixel lies in the distorted camera image (OpenCV radial-tangential model).
+    let p = t * g.image.yz;
+    let x = (p.x - g.intrinsics.z) / g.intrinsics.x;
+    let y = (p.y - g.intrinsics.w) / g.intrinsics.y;
+    let r2 = x * x + y * y;
+    let k = g.distortion;
+    let radial = 1.0 + r2 * (k.x + r2 * (k.y + r2 * g.image.x));
+    let xd = x * radial + 2.0 * k.z * x * y + k.w * (r2 + 2.0 * x * x);
+    let yd = y * radial + k.z * (r2 + 2.0 * y * y) + 2.0 * k.w * x * y;
+    let uv = vec2<f32>(g.intrinsics.x * xd + g.intrinsics.z, g.intrinsics.y * yd + g.intrinsics.w)
+        / g.image.yz;
+    if (uv.x < 0.0 || uv.x > 1.0 || uv.y < 0.0 || uv.y > 1.0) {
+        return vec4<f32>(0.0, 0.0, 0.0, 1.0);
+    }
+    return vec4<f32>(textureSampleLevel(background, linear_sampler, uv, 0.0).rgb, 1.0);
+}
+
+// ---- scene occluder (depth only) and debug lines ----
+
+struct PositionOut {
+    @builtin(position) clip: vec4<f32>,
+}
+
+@vertex
+fn vs_position(@location(0) position: vec3<f32>) -> PositionOut {
+    var out: PositionOut;
+    out.clip = g.clip_from_world * vec4<f32>(position, 1.0);
+    return out;
+}
+
+@fragment
+fn fs_depth_only(s: PositionOut) -> @location(0) vec4<f32> {
+    return vec4<f32>(0.0);
+}
+
+@fragment
+fn fs_wire(s: PositionOut) -> @location(0) vec4<f32> {
+    return vec4<f32>(0.1, 0.95, 1.0, 1.0);
+}
+
+// ---- ground plane: a shadow catcher over the camera image, or a lawn outside AR ----
+
+struct GroundOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) world: vec3<f32>,
+    @location(1) local: vec2<f32>,
+}
+
+@vertex
+fn vs_ground(@builtin(vertex_index) i: u32) -> GroundOut {
+    var corners = array<vec2<f32>, 6>(
+        vec2<f32>(-1.0, -1.0), vec2<f32>(1.0, -1.0), vec2<f32>(1.0, 1.0),
+        vec2<f32>(-1.0, -1.0), vec2<f32>(1.0, 1.0), vec2<f32>(-1.0, 1.0),
+    );
+    let c = corners[i];
+    let normal = normalize(cross(g.ground_v.xyz, g.ground_u.xyz));
+    // Lifted 5 mm so the shadow wins the depth test against the scene's own ground triangles.
+    let world = g.ground_origin.xyz + (g.ground_u.xyz * c.x + g.ground_v.xyz * c.y) * g.ground_origin.w
+        + normal * 0.005;
+    var out: GroundOut;
+    out.clip = g.clip_from_world * vec4<f32>(world, 1.0);
+    out.world = world;
+    out.local = c;
+    return out;
+}
+
+@fragment
+fn fs_ground_shadow(s: GroundOut) -> @location(0) vec4<f32> {
+    let normal = normalize(cross(g.ground_v.xyz, g.ground_u.xyz));
+    let shadow = 1.0 - sun_visibility(s.world, normal);
+    let fade = 1.0 - smoothstep(0.75, 1.0, length(s.local));
+    return vec4<f32>(0.0, 0.0, 0.0, g.ground_v.w * shadow * fade);
+}
+
+@fragment
+fn fs_ground_lawn(s: GroundOut) -> @location(0) vec4<f32> {
+    let normal = normalize(cross(g.ground_v.xyz, g.ground_u.xyz));
+    let fade = 1.0 - smoothstep(0.8, 1.0, length(s.local));
+    return vec4<f32>(shade(LAWN, normal, s.world, 1.0), fade);
+}
+
+// ---- debug overlays: feature points and the brush sphere ----
+
+@vertex
+fn vs_points(@builtin(vertex_index) i: u32, @location(0) position: vec3<f32>) -> PositionOut {
+    var corners = array<vec2<f32>, 6>(
+        vec2<f32>(-1.0, -1.0), vec2<f32>(1.0, -1.0), vec2<f32>(1.0, 1.0),
+        vec2<f32>(-1.0, -1.0), vec2<f32>(1.0, 1.0), vec2<f32>(-1.0, 1.0),
+    );
+    var clip = g.clip_from_world * vec4<f32>(position, 1.0);
+    let offset = corners[i] * g.misc.x / g.viewport.zw;
+    clip = vec4<f32>(clip.xy + offset * clip.w, clip.zw);
+    var out: PositionOut;
+    out.clip = clip;
+    return out;
+}
+
+@fragment
+fn fs_points(s: PositionOut) -> @location(0) vec4<f32> {
+    return vec4<f32>(1.0, 0.85, 0.1, 1.0);
+}
+
+const BRUSH_RINGS: u32 = 12u;
+const BRUSH_SEGMENTS: u32 = 24u;
+
+struct BrushOut {
+    @builtin(position) clip: vec4<f32>,
+    @location(0) normal: vec3<f32>,
+}
+
+@vertex
+fn vs_brush(@builtin(vertex_index) i: u32) -> BrushOut {
+    let quad = i / 6u;
+    var offsets = array<vec2<u32>, 6>(
+        vec2<u32>(0u, 0u), vec2<u32>(1u, 0u), vec2<u32>(1u, 1u),
+        vec2<u32>(0u, 0u), vec2<u32>(1u, 1u), vec2<u32>(0u, 1u),
+    );
+    let o = offsets[i % 6u];
+    let ring = quad / BRUSH_SEGMENTS + o.y;
+    let segment = quad % BRUSH_SEGMENTS + o.x;
+    let theta = 3.14159265 * f32(ring) / f32(BRUSH_RINGS);
+    let phi = 6.2831853 * f32(segment) / f32(BRUSH_SEGMENTS);
+    let n = vec3<f32>(sin(theta) * cos(phi), cos(theta), sin(theta) * sin(phi));
+    var out: BrushOut;
+    out.clip = g.clip_from_world * vec4<f32>(g.brush.xyz + n * g.brush.w, 1.0);
+    out.normal = n;
+    return out;
+}
+
+@fragment
+fn fs_brush(s: BrushOut) -> @location(0) vec4<f32> {
+    let lit = 0.6 + 0.4 * max(dot(normalize(s.normal), g.sun_direction.xyz), 0.0);
+    return vec4<f32>(vec3<f32>(0.85, 0.92, 1.0) * lit, 0.35);
+}

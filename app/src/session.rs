@@ -1,0 +1,233 @@
+//! Recorded sessions: the footage reference, per-frame tracking output, every input event with
+//! its frame and time, the parameters and seeds. Replaying one headlessly gives the same tree and
+//! the same frames on every run.
+
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+use anyhow::{Context, bail};
+use glam::Mat4;
+use serde::{Deserialize, Serialize};
+
+use crate::footage::{Footage, occluder_from_depth};
+use crate::render::offscreen::OFFSCREEN_FORMAT;
+use crate::render::{FrameView, Gpu, GroundPlane, Offscreen, Renderer, ViewCamera};
+use crate::state::{DesignState, InputEvent, Parameters};
+
+pub const SESSION_FORMAT: &str = "sylva-session";
+pub const SESSION_VERSION: u32 = 1;
+
+/// Tracking output for one frame.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct FrameRecord {
+    pub index: usize,
+    pub time_s: f64,
+    /// Column-major `world_from_camera`, absent while tracking is lost.
+    pub world_from_camera: Option<[f32; 16]>,
+    /// Ground plane (point, normal) once found.
+    pub ground: Option<[f32; 6]>,
+}
+
+/// An input event and when it happened.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct TimedEvent {
+    pub frame: usize,
+    pub time_s: f64,
+    pub event: InputEvent,
+}
+
+/// A session file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+pub struct Session {
+    pub format: String,
+    pub version: u32,
+    /// Footage folder, relative to the session file's folder (or absolute).
+    pub footage: PathBuf,
+    pub seed: u64,
+    pub parameters: Parameters,
+    /// Size of replayed frames, pixels.
+    pub frame_size: [u32; 2],
+    pub frames: Vec<FrameRecord>,
+    pub events: Vec<TimedEvent>,
+}
+
+impl Session {
+    /// An empty session on the footage at `footage_ref`.
+    pub fn new(footage_ref: PathBuf, seed: u64, parameters: Parameters) -> Session {
+        Session {
+            format: SESSION_FORMAT.into(),
+            version: SESSION_VERSION,
+            footage: footage_ref,
+            seed,
+            parameters,
+            frame_size: [320, 240],
+            frames: Vec::new(),
+            events: Vec::new(),
+        }
+    }
+
+    /// Records that footage frame `index` was shown next, with its tracking output.
+    pub fn push_frame(&mut self, footage: &Footage, index: usize) {
+        let Some(frame) = footage.frames.get(index) else {
+            return;
+        };
+        self.frames.push(FrameRecord {
+            index,
+            time_s: frame.time_s,
+            world_from_camera: frame.world_from_camera.map(|m| m.to_cols_array()),
+            ground: Some([0.0, 0.0, 0.0, 0.0, 1.0, 0.0]),
+        });
+    }
+
+    /// Records an event that happened after the last recorded frame: a replay applies it just
+    /// before the next one, as the live app did.
+    pub fn record(&mut self, event: InputEvent) {
+        let time_s = self.frames.last().map_or(0.0, |f| f.time_s);
+        self.events.push(TimedEvent {
+            frame: self.frames.len(),
+            time_s,
+            event,
+        });
+    }
+
+    pub fn load(path: &Path) -> anyhow::Result<Session> {
+        let text = std::fs::read_to_string(path)
+            .with_context(|| format!("cannot read session {}", path.display()))?;
+        let session: Session = serde_json::from_str(&text)
+            .with_context(|| format!("{} is not a valid session file", path.display()))?;
+        if session.format != SESSION_FORMAT || session.version != SESSION_VERSION {
+            bail!(
+                "{}: format `{}` version {} (this build reads `{SESSION_FORMAT}` version {SESSION_VERSION})",
+                path.display(),
+                session.format,
+                session.version
+            );
+        }
+        Ok(session)
+    }
+
+    pub fn save(&self, path: &Path) -> anyhow::Result<()> {
+        let json = serde_json::to_string_pretty(self)?;
+        std::fs::write(path, json).with_context(|| format!("cannot write {}", path.display()))
+    }
+}
+
+/// What a replay produced.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ReplayReport {
+    pub tree_sha256: String,
+    /// SHA-256 of each frame's RGBA pixels (empty when frames are not rendered).
+    pub frame_sha256: Vec<String>,
+    pub num_frames: usize,
+    pub ms_per_frame: f64,
+}
+
+impl ReplayReport {
+    pub fn summary_line(&self) -> String {
+        format!(
+            "tree_sha256={} frames={} ms_per_frame={:.1}",
+            self.tree_sha256, self.num_frames, self.ms_per_frame
+        )
+    }
+}
+
+/// The camera of a recorded frame.
+pub fn frame_camera(record: &FrameRecord, footage: &Footage) -> Option<ViewCamera> {
+    let m = record.world_from_camera?;
+    Some(ViewCamera::new(
+        footage.intrinsics,
+        Mat4::from_cols_array(&m),
+    ))
+}
+
+/// Replays `session` (located at `session_path`); writes PNG frames and the tree into `out` when
+/// given, and renders frames when `render` is set.
+pub fn replay(
+    session_path: &Path,
+    out: Option<&Path>,
+    render: bool,
+    mut on_frame: impl FnMut(usize, &DesignState),
+) -> anyhow::Result<ReplayReport> {
+    let session = Session::load(session_path)?;
+    let base = session_path.parent().unwrap_or(Path::new("."));
+    let footage = Footage::open(&base.join(&session.footage))?;
+    if let Some(out) = out {
+        std::fs::create_dir_all(out).with_context(|| format!("cannot create {}", out.display()))?;
+    }
+    let mut gpu_parts = if render {
+        let gpu = Gpu::headless()?;
+        let renderer = Renderer::new(&gpu, OFFSCREEN_FORMAT);
+        let target = Offscreen::new(&gpu.device, session.frame_size[0], session.frame_size[1]);
+        Some((gpu, renderer, target))
+    } else {
+        None
+    };
+    let mut state = DesignState::new(session.seed, session.parameters.clone());
+    let mut meshed_revision = None;
+    let mut frame_sha256 = Vec::new();
+    let mut events = session.events.iter().peekable();
+    let started = Instant::now();
+    let mut previous_time = session.frames.first().map_or(0.0, |f| f.time_s);
+    for (step, record) in session.frames.iter().enumerate() {
+        let camera = frame_camera(record, &footage);
+        let index = record.index;
+        while let Some(e) = events.next_if(|e| e.frame <= step) {
+            state.apply(&e.event);
+        }
+        let dt = frame_dt(record.time_s - previous_time);
+        previous_time = record.time_s;
+        state.advance_frame(camera, record.time_s, dt);
+        on_frame(step, &state);
+        let (Some((gpu, renderer, target)), Some(camera)) = (gpu_parts.as_mut(), camera) else {
+            continue;
+        };
+        if meshed_revision != Some(state.revision) {
+            renderer.set_tree(gpu, &crate::tree_model::mesh_of(&state.tree));
+            meshed_revision = Some(state.revision);
+        }
+        let rgba = footage.load_rgba(index)?;
+        renderer.set_camera_image(gpu, rgba.as_raw(), footage.intrinsics);
+        if let Some(depth) = footage.load_depth_m(index)? {
+            renderer.set_occluder(
+                gpu,
+                &occluder_from_depth(&depth, &footage.intrinsics, camera.world_from_camera, 8),
+            );
+        }
+        let ground = record.ground.map(|g| GroundPlane {
+            point: glam::Vec3::new(g[0], g[1], g[2]),
+            normal: glam::Vec3::new(g[3], g[4], g[5]),
+        });
+        let image = target.render(gpu, renderer, &FrameView::augmented(camera, ground))?;
+        use sha2::Digest;
+        frame_sha256.push(format!("{:x}", sha2::Sha256::digest(image.as_raw())));
+        if let Some(out) = out {
+            let path = out.join(format!("frame_{step:04}.png"));
+            image
+                .save(&path)
+                .with_context(|| format!("cannot write {}", path.display()))?;
+        }
+    }
+    let num_frames = session.frames.len();
+    let ms_per_frame = started.elapsed().as_secs_f64() * 1000.0 / num_frames.max(1) as f64;
+    if let Some(out) = out {
+        let path = out.join("tree.json");
+        std::fs::write(&path, serde_json::to_vec_pretty(&state.tree)?)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    Ok(ReplayReport {
+        tree_sha256: state.tree_sha256(),
+        frame_sha256,
+        num_frames,
+        ms_per_frame,
+    })
+}
+
+/// Time step between two shown frames: the footage's, or one 30 Hz frame when playback looped
+/// or jumped.
+pub fn frame_dt(dt_s: f64) -> f32 {
+    if dt_s > 0.0 && dt_s < 0.5 {
+        dt_s as f32
+    } else {
+        1.0 / 30.0
+    }
+}

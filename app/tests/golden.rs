@@ -1,0 +1,330 @@
+//! Golden images rendered on lavapipe (Mesa's CPU Vulkan): a grown tree from fixed views, an AR
+//! composite where a wall in front hides the lower trunk, and the tree's shadow on the ground.
+//!
+//! Tolerance: a pixel differs when any channel differs by more than 12 (of 255); an image matches
+//! when at most 0.5 % of its pixels differ. On a mismatch the test writes `NAME-actual.png` and
+//! `NAME-difference.png` next to the golden. `SYLVA_BLESS=1` rewrites the goldens.
+//!
+//! Run: `XDG_RUNTIME_DIR=/tmp/sylva-xdg WGPU_BACKEND=vulkan cargo test --release -p sylva-app --test golden`
+
+use std::path::PathBuf;
+
+use glam::Vec3;
+use image::{Rgba, RgbaImage};
+use sylva_app::render::offscreen::OFFSCREEN_FORMAT;
+use sylva_app::render::{
+    FrameView, Gpu, GroundPlane, Intrinsics, OccluderMesh, Offscreen, Renderer, TreeMesh,
+    ViewCamera,
+};
+
+const CHANNEL_TOLERANCE: u8 = 12;
+const MAX_DIFFERING_FRACTION: f64 = 0.005;
+const WIDTH: u32 = 320;
+const HEIGHT: u32 = 240;
+
+fn golden_dir() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/golden")
+}
+
+struct Bench {
+    gpu: Gpu,
+    renderer: Renderer,
+    target: Offscreen,
+}
+
+fn bench_with(tree: &TreeMesh) -> Bench {
+    let gpu = Gpu::headless().expect("a wgpu adapter (lavapipe: WGPU_BACKEND=vulkan)");
+    let mut renderer = Renderer::new(&gpu, OFFSCREEN_FORMAT);
+    renderer.set_tree(&gpu, tree);
+    let target = Offscreen::new(&gpu.device, WIDTH, HEIGHT);
+    Bench {
+        gpu,
+        renderer,
+        target,
+    }
+}
+
+impl Bench {
+    fn render(&mut self, view: &FrameView) -> RgbaImage {
+        let image = self
+            .target
+            .render(&self.gpu, &mut self.renderer, view)
+            .expect("offscreen frame");
+        if let Some(dir) = std::env::var_os("SYLVA_GOLDEN_DEBUG") {
+            let n = std::fs::read_dir(&dir).map_or(0, |d| d.count());
+            let _ = image.save(PathBuf::from(dir).join(format!("debug-{n:03}.png")));
+        }
+        image
+    }
+}
+
+fn grown_tree() -> TreeMesh {
+    sylva_app::tree_model::golden_tree_mesh()
+}
+
+fn differs(a: &Rgba<u8>, b: &Rgba<u8>, tolerance: u8) -> bool {
+    a.0.iter()
+        .zip(b.0.iter())
+        .any(|(x, y)| x.abs_diff(*y) > tolerance)
+}
+
+/// Compares with the golden `name`.png under the stated tolerance.
+fn assert_matches_golden(name: &str, actual: &RgbaImage) {
+    let dir = golden_dir();
+    let path = dir.join(format!("{name}.png"));
+    if std::env::var_os("SYLVA_BLESS").is_some() {
+        std::fs::create_dir_all(&dir).expect("golden dir");
+        actual.save(&path).expect("write golden");
+        return;
+    }
+    let expected = image::open(&path)
+        .unwrap_or_else(|e| {
+            panic!(
+                "golden {} unreadable ({e}); run with SYLVA_BLESS=1 to create it",
+                path.display()
+            )
+        })
+        .to_rgba8();
+    assert_eq!(
+        expected.dimensions(),
+        actual.dimensions(),
+        "{name}: size differs"
+    );
+    let mut difference = RgbaImage::new(actual.width(), actual.height());
+    let mut num_differing = 0usize;
+    for (x, y, a) in actual.enumerate_pixels() {
+        let e = expected.get_pixel(x, y);
+        if differs(a, e, CHANNEL_TOLERANCE) {
+            num_differing += 1;
+            difference.put_pixel(x, y, Rgba([255, 0, 0, 255]));
+        } else {
+            let l = a.0[0] / 3 + a.0[1] / 3 + a.0[2] / 3;
+            difference.put_pixel(x, y, Rgba([l, l, l, 255]));
+        }
+    }
+    let fraction = num_differing as f64 / (actual.width() * actual.height()) as f64;
+    if fraction > MAX_DIFFERING_FRACTION {
+        actual
+            .save(dir.join(format!("{name}-actual.png")))
+            .expect("write actual");
+        difference
+            .save(dir.join(format!("{name}-difference.png")))
+            .expect("write difference");
+        panic!(
+            "{name}: {num_differing} pixels ({:.3} %) differ by more than {CHANNEL_TOLERANCE}, allowed {:.3} %; see {name}-actual.png and {name}-difference.png in {}",
+            fraction * 100.0,
+            MAX_DIFFERING_FRACTION * 100.0,
+            dir.display()
+        );
+    }
+}
+
+fn num_pixels_unlike(image: &RgbaImage, colour: Rgba<u8>) -> usize {
+    image.pixels().filter(|p| differs(p, &colour, 20)).count()
+}
+
+#[test]
+fn a_grown_tree_from_three_fixed_views_matches_its_goldens() {
+    let tree = grown_tree();
+    let (lo, hi) = tree.bounds().expect("the tree has geometry");
+    let centre = 0.5 * (lo + hi);
+    let distance = (hi - lo).length() * 1.3;
+    let mut bench = bench_with(&tree);
+    let k = Intrinsics::from_fov(WIDTH, HEIGHT, 1.0);
+    let views = [
+        ("tree_front", Vec3::new(0.0, 0.3, 1.0)),
+        ("tree_side", Vec3::new(1.0, 0.45, 0.1)),
+        ("tree_above", Vec3::new(0.3, 1.0, 0.6)),
+    ];
+    for (name, direction) in views {
+        let eye = centre + direction.normalize() * distance;
+        let image = bench.render(&FrameView::tree_only(ViewCamera::looking_at(
+            k, eye, centre,
+        )));
+        // The tree fills a real part of the frame: neither empty nor all bark.
+        let sky_corner = *image.get_pixel(2, 2);
+        let covered = num_pixels_unlike(&image, sky_corner);
+        assert!(
+            covered > 2_000,
+            "{name}: only {covered} pixels differ from the sky"
+        );
+        assert_matches_golden(name, &image);
+    }
+}
+
+/// A synthetic AR frame: lawn below the horizon, sky above, and a 0.4 m high wall (a box) 0.7 m
+/// in front of the tree; the camera image is rendered on the CPU from the same camera.
+struct WallScene {
+    camera: ViewCamera,
+    wall: OccluderMesh,
+    wall_top: f32,
+    image: RgbaImage,
+}
+
+const WALL: Rgba<u8> = Rgba([176, 120, 96, 255]);
+
+fn wall_scene() -> WallScene {
+    let k = Intrinsics::from_fov(WIDTH, HEIGHT, 1.1);
+    let camera = ViewCamera::looking_at(k, Vec3::new(0.0, 0.9, 2.6), Vec3::new(0.0, 0.6, 0.0));
+    let wall_top = 0.4;
+    let (wall_lo, wall_hi) = (Vec3::new(-0.6, 0.0, 0.65), Vec3::new(0.6, wall_top, 0.75));
+    let mut wall = OccluderMesh::default();
+    wall.add_box(wall_lo, wall_hi);
+    let eye = camera.position();
+    let image = RgbaImage::from_fn(WIDTH, HEIGHT, |x, y| {
+        let ray_in_camera = k.ray_from_pixel(glam::Vec2::new(x as f32 + 0.5, y as f32 + 0.5));
+        let ray = camera.world_from_camera.transform_vector3(ray_in_camera);
+        // Front face of the wall (z = wall_hi.z, facing the camera).
+        let t_wall = (wall_hi.z - eye.z) / ray.z;
+        let at_wall = eye + ray * t_wall;
+        if t_wall > 0.0
+            && (wall_lo.x..=wall_hi.x).contains(&at_wall.x)
+            && (wall_lo.y..=wall_hi.y).contains(&at_wall.y)
+        {
+            return WALL;
+        }
+        // Its top face, seen from above.
+        let t_top = (wall_hi.y - eye.y) / ray.y;
+        let at_top = eye + ray * t_top;
+        if t_top > 0.0
+            && (wall_lo.x..=wall_hi.x).contains(&at_top.x)
+            && (wall_lo.z..=wall_hi.z).contains(&at_top.z)
+        {
+            return WALL;
+        }
+        if ray.y < 0.0 {
+            let g = eye + ray * (-eye.y / ray.y);
+            let stripe = ((g.x * 4.0).floor() as i32 & 1) as u8 * 12;
+            Rgba([70 + stripe, 130 + stripe, 60, 255])
+        } else {
+            Rgba([170, 200, 235, 255])
+        }
+    });
+    WallScene {
+        camera,
+        wall,
+        wall_top,
+        image,
+    }
+}
+
+/// Pixels along the trunk's first internodes, with their heights.
+fn trunk_pixels(camera: &ViewCamera, heights: &[f32]) -> Vec<(f32, u32, u32)> {
+    heights
+        .iter()
+        .filter_map(|&h| {
+            let p = camera.pixel_from_world(sylva_app::tree_model::golden_trunk_point(h))?;
+            Some((h, p.x as u32, p.y as u32))
+        })
+        .collect()
+}
+
+#[test]
+fn in_ar_a_wall_in_front_hides_the_lower_trunk_and_not_the_upper() {
+    let scene = wall_scene();
+    let mut bench = bench_with(&grown_tree());
+    bench.renderer.set_occluder(&bench.gpu, &scene.wall);
+    bench
+        .renderer
+        .set_camera_image(&bench.gpu, scene.image.as_raw(), scene.camera.intrinsics);
+    let mut view = FrameView::augmented(scene.camera, Some(GroundPlane::default()));
+    view.lighting.shadow_strength = 0.0;
+    let occluded = bench.render(&view);
+    view.occlude = false;
+    let unoccluded = bench.render(&view);
+
+    // The wall is nearer than the tree everywhere, so a trunk point is hidden exactly where
+    // the camera image shows the wall at its pixel.
+    let heights: Vec<f32> = (1..20).map(|i| i as f32 * 0.04).collect();
+    let (mut num_hidden, mut num_visible) = (0, 0);
+    for (h, x, y) in trunk_pixels(&scene.camera, &heights) {
+        let background = *scene.image.get_pixel(x, y);
+        let drawn = *occluded.get_pixel(x, y);
+        if background == WALL {
+            num_hidden += 1;
+            assert!(
+                h < scene.wall_top,
+                "a point above the wall top cannot be hidden"
+            );
+            assert!(
+                !differs(&drawn, &WALL, 3),
+                "trunk at {h} m behind the wall was drawn at ({x}, {y}): {drawn:?}"
+            );
+            assert!(
+                differs(unoccluded.get_pixel(x, y), &WALL, 20),
+                "without occlusion the trunk at {h} m must show at ({x}, {y})"
+            );
+        } else {
+            num_visible += 1;
+            assert!(
+                differs(&drawn, &background, 20),
+                "visible trunk at {h} m is missing at ({x}, {y})"
+            );
+        }
+    }
+    assert!(
+        num_hidden >= 3 && num_visible >= 3,
+        "hidden {num_hidden}, visible {num_visible}: the scene must test both"
+    );
+    assert_matches_golden("ar_wall_occlusion", &occluded);
+}
+
+#[test]
+fn the_tree_casts_a_soft_shadow_on_the_ground() {
+    let tree = grown_tree();
+    let (lo, hi) = tree.bounds().expect("the tree has geometry");
+    let crown = 0.5 * (lo + hi);
+    let mut bench = bench_with(&tree);
+    let plain = RgbaImage::from_pixel(WIDTH, HEIGHT, Rgba([150, 150, 150, 255]));
+    let k = Intrinsics::from_fov(WIDTH, HEIGHT, 1.2);
+    bench
+        .renderer
+        .set_camera_image(&bench.gpu, plain.as_raw(), k);
+    let eye = crown + Vec3::new(0.0, 2.5, 2.2);
+    let mut view = FrameView::augmented(
+        ViewCamera::looking_at(k, eye, Vec3::ZERO),
+        Some(GroundPlane::default()),
+    );
+    let sun = view.lighting.sun_direction;
+    let image = bench.render(&view);
+    // The crown's shadow falls where the ray from the crown centre away from the sun meets y = 0.
+    let shadow_centre = crown - sun * (crown.y / sun.y);
+    // In front of the tree towards the camera and away from the sun: lit and not hidden by the tree.
+    let size = (hi - lo).length();
+    let lit_ground = Vec3::new(0.3 * size * sun.x.signum(), 0.0, 0.6 * size);
+    let is_shadow = |p: &Rgba<u8>| p.0[0] == p.0[1] && p.0[1] == p.0[2] && p.0[0] < 140;
+    let num_shadowed_near = |centre: Vec3| {
+        let c = view
+            .camera
+            .pixel_from_world(centre)
+            .expect("in front of the camera");
+        image
+            .enumerate_pixels()
+            .filter(|(x, y, p)| {
+                glam::Vec2::new(*x as f32, *y as f32).distance(c) < 40.0 && is_shadow(p)
+            })
+            .count()
+    };
+    let near_shadow = num_shadowed_near(shadow_centre);
+    let near_lit = num_shadowed_near(Vec3::new(lit_ground.x, 0.0, lit_ground.z));
+    assert!(
+        near_shadow > 60,
+        "only {near_shadow} shadowed pixels where the crown's shadow falls"
+    );
+    assert_eq!(near_lit, 0, "shadow where the sun shines");
+    // Soft: between full shadow and no shadow there are intermediate tones.
+    let num_tones = image
+        .pixels()
+        .filter(|p| p.0[0] == p.0[1] && p.0[1] == p.0[2] && p.0[0] < 150)
+        .map(|p| p.0[0])
+        .collect::<std::collections::BTreeSet<_>>()
+        .len();
+    assert!(num_tones > 20, "only {num_tones} shadow tones: not soft");
+    view.lighting.shadow_strength = 0.0;
+    let unshadowed = bench.render(&view);
+    assert!(
+        num_pixels_unlike(&unshadowed, plain.get_pixel(0, 0).to_owned())
+            < num_pixels_unlike(&image, *plain.get_pixel(0, 0))
+    );
+    assert_matches_golden("ground_shadow", &image);
+}
