@@ -1,12 +1,39 @@
 //! The incremental two-layer triangulation: insert, remove, move, per-frame update.
 
 use std::collections::{HashMap, HashSet};
+use std::hash::{BuildHasherDefault, Hasher};
 
 use glam::Vec2;
 use spade::handles::FixedVertexHandle;
 use spade::{DelaunayTriangulation, HasPosition, HierarchyHintGenerator, Point2, Triangulation};
 
 use super::{DepthMeshConfig, DepthMeshError, Observation, PinholeIntrinsics};
+
+/// Map-point ids are already well spread integers: a multiplicative hash (Fibonacci hashing)
+/// is enough and several times faster than SipHash on this hot path.
+#[derive(Default)]
+pub(crate) struct IdHasher(u64);
+
+impl Hasher for IdHasher {
+    fn finish(&self) -> u64 {
+        self.0
+    }
+
+    fn write(&mut self, bytes: &[u8]) {
+        for &byte in bytes {
+            self.0 = (self.0.rotate_left(8) ^ byte as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15);
+        }
+    }
+
+    fn write_u64(&mut self, value: u64) {
+        self.0 = (self.0 ^ value)
+            .wrapping_mul(0x9e37_79b9_7f4a_7c15)
+            .rotate_left(29);
+    }
+}
+
+pub(crate) type IdMap<V> = HashMap<u64, V, BuildHasherDefault<IdHasher>>;
+pub(crate) type IdSet = HashSet<u64, BuildHasherDefault<IdHasher>>;
 
 /// A vertex: pixel position, depth and the map point it came from.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -33,12 +60,18 @@ pub(crate) type Triangles =
 #[derive(Default)]
 pub(crate) struct Layer {
     pub(crate) triangles: Triangles,
-    pub(crate) handles: HashMap<u64, FixedVertexHandle>,
+    pub(crate) handles: IdMap<FixedVertexHandle>,
 }
 
 impl Layer {
-    fn insert(&mut self, vertex: MeshVertex) -> Result<(), DepthMeshError> {
-        if let Some(existing) = self.triangles.locate_vertex(vertex.position()) {
+    /// Inserts a vertex. Spade would silently overwrite a vertex at the same position, so the
+    /// caller checks for duplicates (`check_duplicate`) unless it already did, or the layer is
+    /// the surface (a subset of the positions of all points, which are unique).
+    fn insert(&mut self, vertex: MeshVertex, check_duplicate: bool) -> Result<(), DepthMeshError> {
+        if let Some(existing) = check_duplicate
+            .then(|| self.triangles.locate_vertex(vertex.position()))
+            .flatten()
+        {
             let other = existing.data().id;
             return Err(DepthMeshError::DuplicatePosition {
                 id: vertex.id,
@@ -72,6 +105,17 @@ impl Layer {
         self.handles
             .get(&id)
             .map(|&h| *self.triangles.vertex(h).data())
+    }
+
+    fn neighbours(&self, id: u64) -> Vec<MeshVertex> {
+        let Some(&handle) = self.handles.get(&id) else {
+            return Vec::new();
+        };
+        self.triangles
+            .vertex(handle)
+            .out_edges()
+            .map(|edge| *edge.to().data())
+            .collect()
     }
 
     fn neighbour_ids(&self, id: u64) -> Vec<u64> {
@@ -166,7 +210,7 @@ impl DepthMesh {
 
     /// Inserts a point, or moves it if its id is already held.
     pub fn insert(&mut self, observation: Observation) -> Result<(), DepthMeshError> {
-        let mut dirty = HashSet::new();
+        let mut dirty = IdSet::default();
         let result = self.insert_or_move(observation, &mut dirty);
         self.refresh(dirty);
         result.map(|_| ())
@@ -182,7 +226,7 @@ impl DepthMesh {
 
     /// Removes a point; unknown ids are an error value.
     pub fn remove(&mut self, id: u64) -> Result<(), DepthMeshError> {
-        let mut dirty = HashSet::new();
+        let mut dirty = IdSet::default();
         if !self.remove_into(id, &mut dirty) {
             return Err(DepthMeshError::UnknownPoint { id });
         }
@@ -194,8 +238,8 @@ impl DepthMesh {
     /// new ones inserted, moved ones moved. Invalid observations are counted and skipped.
     pub fn update(&mut self, observations: &[Observation]) -> UpdateStats {
         let mut stats = UpdateStats::default();
-        let mut dirty = HashSet::new();
-        let seen: HashSet<u64> = observations.iter().map(|o| o.id).collect();
+        let mut dirty = IdSet::default();
+        let seen: IdSet = observations.iter().map(|o| o.id).collect();
         let lost: Vec<u64> = self
             .all
             .handles
@@ -220,7 +264,7 @@ impl DepthMesh {
         stats
     }
 
-    fn remove_into(&mut self, id: u64, dirty: &mut HashSet<u64>) -> bool {
+    fn remove_into(&mut self, id: u64, dirty: &mut IdSet) -> bool {
         let neighbours = self.all.neighbour_ids(id);
         if self.all.remove(id).is_none() {
             return false;
@@ -234,7 +278,7 @@ impl DepthMesh {
     fn insert_or_move(
         &mut self,
         observation: Observation,
-        dirty: &mut HashSet<u64>,
+        dirty: &mut IdSet,
     ) -> Result<Change, DepthMeshError> {
         let vertex = self.validate(&observation)?;
         let change = match self.all.get(vertex.id) {
@@ -273,7 +317,7 @@ impl DepthMesh {
         if change == Change::Moved {
             self.remove_into(vertex.id, dirty);
         }
-        self.all.insert(vertex)?;
+        self.all.insert(vertex, false)?;
         dirty.insert(vertex.id);
         dirty.extend(self.all.neighbour_ids(vertex.id));
         Ok(change)
@@ -284,9 +328,9 @@ impl DepthMesh {
     /// Two passes: the first lets any neighbours support a vertex; the second only those
     /// found consistent (by the first pass for dirty vertices, by the surface for the rest),
     /// so outliers cannot vouch for each other.
-    fn refresh(&mut self, dirty: HashSet<u64>) {
+    fn refresh(&mut self, dirty: IdSet) {
         let vertices: Vec<MeshVertex> = dirty.iter().filter_map(|&id| self.all.get(id)).collect();
-        let first: HashMap<u64, bool> = vertices
+        let first: IdMap<bool> = vertices
             .iter()
             .map(|v| (v.id, self.is_supported(v, &|_| true, false)))
             .collect();
@@ -304,11 +348,11 @@ impl DepthMesh {
             let id = vertex.id;
             match (consistent, self.surface.get(id)) {
                 (true, None) => {
-                    let _ = self.surface.insert(vertex);
+                    let _ = self.surface.insert(vertex, false);
                 }
                 (true, Some(old)) if old.pixel != vertex.pixel => {
                     self.surface.remove(id);
-                    let _ = self.surface.insert(vertex);
+                    let _ = self.surface.insert(vertex, false);
                 }
                 (true, Some(_)) => {}
                 (false, Some(_)) => {
@@ -331,12 +375,12 @@ impl DepthMesh {
         if self.all.handles.len() < 5 {
             return true;
         }
-        let ring = self.all.neighbour_ids(vertex.id);
+        let ring = self.all.neighbours(vertex.id);
         let mut candidates: Vec<MeshVertex> = ring
             .iter()
-            .filter(|&&id| trusted(id))
-            .filter_map(|&id| self.all.get(id))
+            .filter(|v| trusted(v.id))
             .take(10)
+            .copied()
             .collect();
         if ring.len() < 3 {
             return true;
@@ -348,17 +392,17 @@ impl DepthMesh {
             return false;
         }
         let num_first = candidates.len();
-        for &id in &ring {
-            for second in self.all.neighbour_ids(id) {
+        for first in &ring {
+            for second in self.all.neighbours(first.id) {
                 if candidates.len() >= 16 {
                     break;
                 }
-                if second != vertex.id
-                    && !ring.contains(&second)
-                    && trusted(second)
-                    && !candidates.iter().any(|c| c.id == second)
+                if second.id != vertex.id
+                    && !ring.iter().any(|r| r.id == second.id)
+                    && trusted(second.id)
+                    && !candidates.iter().any(|c| c.id == second.id)
                 {
-                    candidates.extend(self.all.get(second));
+                    candidates.push(second);
                 }
             }
         }

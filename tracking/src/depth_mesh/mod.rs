@@ -80,6 +80,20 @@ impl PinholeIntrinsics {
     }
 }
 
+impl From<&crate::camera::Camera> for PinholeIntrinsics {
+    /// The pinhole part of the tracker's camera (the tracker hands over undistorted pixels).
+    fn from(camera: &crate::camera::Camera) -> Self {
+        Self {
+            width: camera.width,
+            height: camera.height,
+            fx: camera.fx as f32,
+            fy: camera.fy as f32,
+            cx: camera.cx as f32,
+            cy: camera.cy as f32,
+        }
+    }
+}
+
 /// One tracked point seen in the current frame.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Observation {
