@@ -247,7 +247,8 @@ impl System {
         }
     }
 
-    /// Solves (H + μ diag H) δ = −g by block Cholesky elimination along the chain.
+    /// Solves (H + μ diag H) δ = −g by block Cholesky elimination along the chain:
+    /// with S_{i−1} = L Lᵀ and W = L⁻¹ U_{i−1}, S_i = D_i − WᵀW and y_i = −g_i − Wᵀ L⁻¹ y_{i−1}.
     fn solve(&mut self, damping: f64) -> &[Vec6] {
         let n = self.diagonal.len();
         for i in 0..n {
@@ -257,21 +258,22 @@ impl System {
             }
             let mut y = self.gradient[i].map(|g| -g);
             if i > 0 {
-                // S_i = D_i − U_{i−1}ᵀ S_{i−1}⁻¹ U_{i−1};  y_i −= U_{i−1}ᵀ S_{i−1}⁻¹ y_{i−1}.
-                let x = self.coupling[i - 1];
-                let z = cholesky_solve(&self.factors[i - 1], self.rhs[i - 1]);
-                let u = &self.upper[i - 1];
+                let w = &self.coupling[i - 1];
+                let z = forward_solve(&self.factors[i - 1], self.rhs[i - 1]);
                 for a in 0..6 {
-                    for b in 0..6 {
+                    for b in a..6 {
                         let mut acc = 0.0;
                         for c in 0..6 {
-                            acc += u[c][a] * x[c][b];
+                            acc += w[c][a] * w[c][b];
                         }
                         s[a][b] -= acc;
+                        if a != b {
+                            s[b][a] -= acc;
+                        }
                     }
                     let mut acc = 0.0;
                     for c in 0..6 {
-                        acc += u[c][a] * z[c];
+                        acc += w[c][a] * z[c];
                     }
                     y[a] -= acc;
                 }
@@ -279,16 +281,15 @@ impl System {
             self.factors[i] = cholesky(s);
             self.rhs[i] = y;
             if i + 1 < n {
-                // X = S_i⁻¹ U_i, column by column.
-                let mut x = [[0.0; 6]; 6];
+                let mut w = [[0.0; 6]; 6];
                 for b in 0..6 {
                     let column = std::array::from_fn(|a| self.upper[i][a][b]);
-                    let solved = cholesky_solve(&self.factors[i], column);
+                    let solved = forward_solve(&self.factors[i], column);
                     for a in 0..6 {
-                        x[a][b] = solved[a];
+                        w[a][b] = solved[a];
                     }
                 }
-                self.coupling[i] = x;
+                self.coupling[i] = w;
             }
         }
         for i in (0..n).rev() {
@@ -359,7 +360,8 @@ fn cholesky(a: Mat6) -> Mat6 {
     l
 }
 
-fn cholesky_solve(l: &Mat6, b: Vec6) -> Vec6 {
+/// Solves L y = b for the lower triangular L.
+fn forward_solve(l: &Mat6, b: Vec6) -> Vec6 {
     let mut y = [0.0; 6];
     for i in 0..6 {
         let mut s = b[i];
@@ -368,6 +370,11 @@ fn cholesky_solve(l: &Mat6, b: Vec6) -> Vec6 {
         }
         y[i] = s / l[i][i];
     }
+    y
+}
+
+fn cholesky_solve(l: &Mat6, b: Vec6) -> Vec6 {
+    let y = forward_solve(l, b);
     let mut x = [0.0; 6];
     for i in (0..6).rev() {
         let mut s = y[i];
