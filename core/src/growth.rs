@@ -201,6 +201,7 @@ impl Tree {
         self.iteration += 1;
         let mut stats = IterationStats::default();
         let mut scratch = std::mem::take(&mut self.scratch);
+        buds::expire_old_buds(self);
         buds::collect(self, &mut scratch);
         light::expose(self, &mut scratch);
         stats.num_points = space::colonize(self, &mut scratch, options);
@@ -225,7 +226,6 @@ impl Tree {
         }
         space::finish_iteration(self, &scratch);
         self.scratch = scratch;
-        self.update_light_exposure();
         self.update_widths();
         stats
     }
@@ -268,7 +268,10 @@ impl Tree {
         count
     }
 
-    fn update_light_exposure(&mut self) {
+    /// Sets every internode's `light_exposure` from the current shadow grid. Growth keeps it
+    /// current only for internodes with living buds (and new ones); call this before reading it
+    /// on a whole tree.
+    pub fn update_light_exposure(&mut self) {
         let s = &self.species;
         let shadow = &self.environment.shadow;
         for node in &mut self.skeleton.internodes {

@@ -85,6 +85,10 @@ pub struct Species {
     pub phyllotactic_angle_deg: f32,
     /// k: buds per whorl (whorled phyllotaxis only).
     pub buds_per_whorl: u32,
+    /// Years a lateral bud stays able to break; older dormant buds die (0 = forever). Keeps the
+    /// competition for space to the young periphery of the crown, as in real trees.
+    #[serde(default)]
+    pub bud_lifetime_years: f32,
     /// Lateral buds only on the last internode of each shoot (rhythmic whorls of conifers).
     pub lateral_buds_only_at_shoot_end: bool,
     /// δ: deflection of the supporting axis away from a growing lateral bud.

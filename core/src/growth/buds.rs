@@ -37,6 +37,25 @@ pub(crate) struct BudState {
     pub competes: bool,
 }
 
+/// Kills lateral buds older than the species' bud lifetime (dormant buds that never broke).
+pub(crate) fn expire_old_buds(tree: &mut Tree) {
+    let s = &tree.species;
+    if s.bud_lifetime_years <= 0.0 {
+        return;
+    }
+    let lifetime = (s.bud_lifetime_years / s.years_per_iteration).ceil() as u32;
+    let Some(cutoff) = tree.iteration.checked_sub(lifetime) else {
+        return;
+    };
+    for node in &mut tree.skeleton.internodes {
+        if node.born_iteration < cutoff && node.lateral_buds.iter().any(|b| b.alive) {
+            for bud in &mut node.lateral_buds {
+                bud.alive = false;
+            }
+        }
+    }
+}
+
 /// Fills `scratch.buds` with every living bud, node by node (terminal first), and the mask.
 pub(crate) fn collect(tree: &Tree, scratch: &mut Scratch) {
     let nodes = &tree.skeleton.internodes;

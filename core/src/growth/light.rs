@@ -7,12 +7,22 @@ use super::buds::TERMINAL;
 use super::{Scratch, Tree};
 use crate::species::ControlEllipse;
 
-/// L = max(C − s + a, 0) for every bud.
-pub(crate) fn expose(tree: &Tree, scratch: &mut Scratch) {
+/// L = max(C − s + a, 0) for every bud (all buds of a node share its voxel), also stored as the
+/// node's `light_exposure`.
+pub(crate) fn expose(tree: &mut Tree, scratch: &mut Scratch) {
     let s = &tree.species;
     let shadow = &tree.environment.shadow;
-    for bud in &mut scratch.buds {
-        bud.light = (s.full_exposure - shadow.shadow_at(bud.position) + s.shadow_strength).max(0.0);
+    let nodes = &mut tree.skeleton.internodes;
+    for (i, node) in nodes.iter_mut().enumerate() {
+        let range = scratch.node_bud_start[i] as usize..scratch.node_bud_start[i + 1] as usize;
+        if range.is_empty() {
+            continue;
+        }
+        let light = (s.full_exposure - shadow.shadow_at(node.end) + s.shadow_strength).max(0.0);
+        node.light_exposure = light;
+        for bud in &mut scratch.buds[range] {
+            bud.light = light;
+        }
     }
 }
 

@@ -205,8 +205,9 @@ fn grow_shoot(
                 parent_mut.lateral_buds.clear();
             }
         }
-        tree.skeleton.internodes.push(node);
         tree.environment.shadow.apply_node(end, 1);
+        node.light_exposure = tree.ambient_at(end) * tree.species.full_exposure;
+        tree.skeleton.internodes.push(node);
         space::consume(scratch, end, r);
         heading = new_heading;
         parent = id.index();
