@@ -2,6 +2,7 @@
 
 use std::path::PathBuf;
 
+pub mod corners;
 pub mod synthetic;
 
 /// The shared test data folder: `$SYLVA_DATA`, else `../shared/test-data` beside the checkout.

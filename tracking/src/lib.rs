@@ -43,3 +43,4 @@ pub use sequence::{FrameSource, SequenceError, SourceEvent, TumSequence};
 pub use tracker::{Tracker, TrackerConfig, TrackerError};
 
 pub mod depth_mesh;
+pub mod occupancy;
