@@ -325,15 +325,23 @@ impl DepthMesh {
 
     /// Re-evaluates the consistency of `dirty` vertices and mirrors them into the surface.
     ///
-    /// Two passes: the first lets any neighbours support a vertex; the second only those
-    /// found consistent (by the first pass for dirty vertices, by the surface for the rest),
-    /// so outliers cannot vouch for each other.
+    /// Support only counts from trusted neighbours, so outliers cannot vouch for each other:
+    /// for a bulk change a lenient first pass (any neighbours) decides whom to trust; otherwise
+    /// the trusted are the vertices already in the surface.
     fn refresh(&mut self, dirty: IdSet) {
         let vertices: Vec<MeshVertex> = dirty.iter().filter_map(|&id| self.all.get(id)).collect();
-        let first: IdMap<bool> = vertices
-            .iter()
-            .map(|v| (v.id, self.is_supported(v, &|_| true, false)))
-            .collect();
+        // The lenient first pass only matters while there is no established surface to trust
+        // (a first frame, a relocalisation); in steady state a frame changes few points and
+        // the surface's own membership is the trust.
+        let bulk = vertices.len() * 4 > self.all.handles.len();
+        let first: IdMap<bool> = if bulk {
+            vertices
+                .iter()
+                .map(|v| (v.id, self.is_supported(v, &|_| true, false)))
+                .collect()
+        } else {
+            IdMap::default()
+        };
         let trusted = |id: u64| {
             first
                 .get(&id)
@@ -430,19 +438,26 @@ impl DepthMesh {
     ) -> bool {
         let w = 1.0 / vertex.depth_m;
         let tolerance = self.config.consistency_tolerance * w;
+        let predicts = |i: usize, j: usize, k: usize| {
+            let triple = [candidates[i], candidates[j], candidates[k]];
+            // A triple bridging a discontinuity predicts every depth in between.
+            !self.bridges_discontinuity(&triple)
+                && predict_inverse_depth(vertex.pixel, triple[0], triple[1], triple[2])
+                    .is_some_and(|predicted| (predicted - w).abs() <= tolerance)
+        };
         let n = candidates.len();
+        // Ring neighbours come in angular order: triples a third of the ring apart surround
+        // the vertex (interpolation, not extrapolation) and usually settle it at once.
+        if first_new == 0 && n >= 3 {
+            let third = n / 3;
+            if (0..third.max(1)).any(|i| predicts(i, i + third, (i + 2 * third).min(n - 1))) {
+                return true;
+            }
+        }
         for i in 0..n {
             for j in i + 1..n {
                 for k in j.max(first_new.saturating_sub(1)) + 1..n {
-                    let triple = [candidates[i], candidates[j], candidates[k]];
-                    // A triple bridging a discontinuity predicts every depth in between.
-                    if self.bridges_discontinuity(&triple) {
-                        continue;
-                    }
-                    let [a, b, c] = triple;
-                    if predict_inverse_depth(vertex.pixel, a, b, c)
-                        .is_some_and(|predicted| (predicted - w).abs() <= tolerance)
-                    {
+                    if predicts(i, j, k) {
                         return true;
                     }
                 }
