@@ -413,23 +413,20 @@ impl RingFrames {
 /// tube (shrunk to the mid-radius of the parent's polygonal contour, so no gap shows).
 fn onto_parent(tube: &ParentTube, ring: &Ring, direction: Vec3, shrink: f32) -> Vec3 {
     let start = ring.center + direction * ring.radius;
-    let surface = |p| tube.at(p);
-    let max_slide = 3.0 * tube.joint_radius();
-    let mut slide = 0.0f32;
-    for _ in 0..1 {
-        let point = start + ring.tangent * slide;
-        let (axis, radius) = surface(point);
-        let offset = point - axis;
-        let distance = offset.length();
-        let gap = radius * shrink - distance;
-        if gap <= 1e-4 * radius || distance < 1e-9 {
-            break;
-        }
+    // One linearised step along the tangent to where the vertex leaves the tube; the radial
+    // projection below then puts it exactly on the surface.
+    let (axis, radius) = tube.at(start);
+    let offset = start - axis;
+    let distance = offset.length();
+    let gap = radius * shrink - distance;
+    let slide = if gap > 1e-4 * radius && distance > 1e-9 {
         let rate = ring.tangent.dot(offset / distance).max(0.25);
-        slide = (slide + gap / rate).min(max_slide);
-    }
+        (gap / rate).min(3.0 * tube.joint_radius())
+    } else {
+        0.0
+    };
     let point = start + ring.tangent * slide;
-    let (axis, radius) = surface(point);
+    let (axis, radius) = tube.at(point);
     let outward = (point - axis)
         .try_normalize()
         .or_else(|| direction.try_normalize())
