@@ -44,6 +44,7 @@ pub fn run_window(
     paused: bool,
 ) -> anyhow::Result<()> {
     let event_loop = EventLoop::new().context("cannot connect to a display")?;
+    event_loop.set_control_flow(winit::event_loop::ControlFlow::Poll);
     let mut player = Player::new(footage, footage_ref);
     player.frame = first_frame.min(player.footage.len().saturating_sub(1));
     player.ui.playing = !paused;

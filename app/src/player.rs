@@ -15,8 +15,8 @@ use crate::ui::UiState;
 
 /// Seed of trees planted by the app.
 pub const DEFAULT_SEED: u64 = 7;
-/// Updates with a pose before the seedling is planted (coaching overlay shown).
-const FRAMES_TO_FIND_GROUND: usize = 15;
+/// Seconds with a pose before the seedling is planted (coaching overlay shown).
+const SECONDS_TO_FIND_GROUND: f64 = 0.5;
 
 /// Footage playback, the design and the session being recorded.
 pub struct Player {
@@ -29,7 +29,7 @@ pub struct Player {
     pub depth: Option<(u32, u32, Vec<f32>)>,
     last_tick_s: Option<f64>,
     frame_clock_s: f64,
-    ticks_with_pose: usize,
+    first_pose_s: Option<f64>,
 }
 
 impl Player {
@@ -49,7 +49,7 @@ impl Player {
             depth: None,
             last_tick_s: None,
             frame_clock_s: 0.0,
-            ticks_with_pose: 0,
+            first_pose_s: None,
         }
     }
 
@@ -102,9 +102,9 @@ impl Player {
         // TEMPORARY STAND-IN for the tracker's plane detection: the ground counts as found after
         // a short run of updates with a camera pose.
         if self.camera().is_some() {
-            self.ticks_with_pose += 1;
+            let first = *self.first_pose_s.get_or_insert(now_s);
+            self.ui.ground_found |= now_s - first >= SECONDS_TO_FIND_GROUND;
         }
-        self.ui.ground_found |= self.ticks_with_pose >= FRAMES_TO_FIND_GROUND;
         if let Some(target) = self.ui.seek_to.take() {
             return self.show_frame(target);
         }

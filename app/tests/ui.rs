@@ -72,6 +72,8 @@ fn brush_stroke(design: &mut DesignState) {
 #[test]
 fn dragging_the_weights_triangle_keeps_the_sum_one_and_changes_growth() {
     let mut h = harness(app());
+    h.get_by_label("Architecture").click();
+    h.run();
     let rect = h.get_by_label("α β γ triangle").rect();
     let before = h.state().design.params.direction_weights;
     h.drag_at(rect.center());

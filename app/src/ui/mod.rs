@@ -34,7 +34,8 @@ pub struct FrameBudget {
 /// UI-only state (not part of the design).
 #[derive(Clone, Debug, PartialEq)]
 pub struct UiState {
-    pub tab: Tab,
+    /// The open top-bar tab (none: only the tab names show, leaving the view free).
+    pub tab: Option<Tab>,
     pub playing: bool,
     pub frame: usize,
     pub num_frames: usize,
@@ -50,7 +51,7 @@ pub struct UiState {
 impl Default for UiState {
     fn default() -> Self {
         UiState {
-            tab: Tab::Architecture,
+            tab: None,
             playing: true,
             frame: 0,
             num_frames: 0,
@@ -82,10 +83,20 @@ pub fn sylva_ui(
                 (Tab::Years, "Years"),
                 (Tab::Export, "Export"),
             ] {
-                ui.selectable_value(&mut state.tab, tab, name);
+                // Tapping the open tab closes it.
+                if ui.selectable_label(state.tab == Some(tab), name).clicked() {
+                    state.tab = if state.tab == Some(tab) {
+                        None
+                    } else {
+                        Some(tab)
+                    };
+                }
             }
         });
-        match state.tab {
+        let Some(tab) = state.tab else {
+            return;
+        };
+        match tab {
             Tab::Architecture => architecture_ui(ui, &mut params),
             Tab::Growth => growth_ui(ui, &mut params),
             Tab::Species => {

@@ -1,0 +1,182 @@
+//! Under Xvfb, `sylva view test-data/demo_garden` shows the camera image with a tree planted on
+//! the ground: a screenshot at two frames of the walk finds tree pixels along the trunk's
+//! projection, and they move with the ground origin as the camera moves.
+//!
+//! Needs `Xvfb` and ImageMagick's `import` (scripts/setup.sh installs both); fails loudly without.
+//! Set `SYLVA_SCREENSHOT_DIR` to keep the screenshots.
+
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::Duration;
+
+use glam::{Vec2, Vec3};
+use image::RgbaImage;
+use sylva_app::footage::Footage;
+use sylva_app::render::ViewCamera;
+use sylva_app::render::resources::letterbox;
+
+const WINDOW: (u32, u32) = (1120, 720);
+
+struct Killed(Child);
+
+impl Drop for Killed {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+fn demo() -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../test-data/demo_garden")
+}
+
+fn start_xvfb() -> (Killed, String) {
+    let display = format!(":{}", 90 + std::process::id() % 100);
+    let child = Command::new("Xvfb")
+        .args([
+            display.as_str(),
+            "-screen",
+            "0",
+            "1280x800x24",
+            "-nolisten",
+            "tcp",
+        ])
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .expect("Xvfb is required for this test (apt-get install xvfb)");
+    let socket = format!("/tmp/.X11-unix/X{}", &display[1..]);
+    for _ in 0..100 {
+        if Path::new(&socket).exists() {
+            break;
+        }
+        std::thread::sleep(Duration::from_millis(100));
+    }
+    (Killed(child), display)
+}
+
+/// Runs the app paused at `frame` and takes a screenshot of the screen.
+fn screenshot(display: &str, frame: usize, dir: &Path) -> RgbaImage {
+    let app = Command::new(env!("CARGO_BIN_EXE_sylva"))
+        .arg("view")
+        .arg(demo())
+        .args(["--frame", &frame.to_string(), "--paused"])
+        .current_dir(dir)
+        .env("DISPLAY", display)
+        .env_remove("WAYLAND_DISPLAY")
+        .stdout(Stdio::null())
+        .stderr(Stdio::inherit())
+        .spawn()
+        .expect("start sylva");
+    let _app = Killed(app);
+    std::thread::sleep(Duration::from_secs(12));
+    let path = dir.join(format!("screenshot-{frame}.png"));
+    let status = Command::new("import")
+        .args(["-display", display, "-window", "root"])
+        .arg(&path)
+        .status()
+        .expect("ImageMagick's import is required for this test");
+    assert!(status.success(), "import failed");
+    image::open(&path).expect("screenshot").to_rgba8()
+}
+
+/// The trunk of the seedling the app plants at the ground origin, at height `h`.
+fn seedling_trunk(h: f32) -> Vec3 {
+    let design = sylva_app::state::DesignState::new(
+        sylva_app::player::DEFAULT_SEED,
+        sylva_app::state::Parameters::default(),
+    );
+    sylva_app::tree_model::trunk_point(&design.tree, h)
+}
+
+/// Window pixel of a world point seen from `camera`, as the renderer letterboxes it.
+fn window_pixel(camera: &ViewCamera, p: Vec3) -> Option<Vec2> {
+    let k = &camera.intrinsics;
+    let region = letterbox(WINDOW, k);
+    let px = camera.pixel_from_world(p)?;
+    Some(Vec2::new(
+        region[0] + px.x / k.width as f32 * region[2],
+        region[1] + px.y / k.height as f32 * region[3],
+    ))
+}
+
+/// Fraction of trunk samples (inside the unobstructed part of the view) whose screenshot pixel
+/// differs from the camera image there, and the mean offset of those tree pixels from the trunk's
+/// projection.
+fn tree_on_trunk(
+    shot: &RgbaImage,
+    camera: &ViewCamera,
+    image: &RgbaImage,
+    base: Vec3,
+) -> (f32, usize) {
+    let region = letterbox(WINDOW, &camera.intrinsics);
+    let (mut num_samples, mut num_tree) = (0, 0);
+    for i in 1..16 {
+        let Some(p) = window_pixel(camera, base + seedling_trunk(i as f32 * 0.04)) else {
+            continue;
+        };
+        if !(100.0..980.0).contains(&p.x) || !(40.0..660.0).contains(&p.y) {
+            continue;
+        }
+        num_samples += 1;
+        let u = ((p.x - region[0]) / region[2] * image.width() as f32) as u32;
+        let v = ((p.y - region[1]) / region[3] * image.height() as f32) as u32;
+        let background = image.get_pixel(u.min(image.width() - 1), v.min(image.height() - 1));
+        // The trunk is a few pixels wide: look at the nearest pixels of the row.
+        let is_tree = (-2..=2).any(|dx| {
+            let s = shot.get_pixel((p.x as i32 + dx) as u32, p.y as u32);
+            s.0.iter()
+                .zip(background.0.iter())
+                .take(3)
+                .any(|(a, b)| a.abs_diff(*b) > 45)
+        });
+        num_tree += usize::from(is_tree);
+    }
+    (num_tree as f32 / num_samples.max(1) as f32, num_samples)
+}
+
+#[test]
+fn under_xvfb_the_window_shows_a_tree_that_stays_on_the_ground_as_the_camera_moves() {
+    let footage = Footage::open(&demo()).expect("demo sequence");
+    let dir = match std::env::var_os("SYLVA_SCREENSHOT_DIR") {
+        Some(d) => PathBuf::from(d),
+        None => std::env::temp_dir().join(format!("sylva-screenshot-{}", std::process::id())),
+    };
+    std::fs::create_dir_all(&dir).expect("screenshot dir");
+    let (_xvfb, display) = start_xvfb();
+    let mut eyes = Vec::new();
+    for frame in [60, 200] {
+        let shot = screenshot(&display, frame, &dir);
+        let pose = footage.frames[frame]
+            .world_from_camera
+            .expect("ground truth pose");
+        let camera = ViewCamera::new(footage.intrinsics, pose);
+        let image = footage.load_rgba(frame).expect("frame image");
+        let (fraction, num_samples) = tree_on_trunk(&shot, &camera, &image, Vec3::ZERO);
+        assert!(
+            num_samples >= 4,
+            "frame {frame}: only {num_samples} trunk samples in view"
+        );
+        assert!(
+            fraction >= 0.6,
+            "frame {frame}: tree pixels at only {:.0} % of the trunk's projection (screenshots in {})",
+            fraction * 100.0,
+            dir.display()
+        );
+        // Where no tree stands (1.2 m to the sunny side), the camera image is unchanged.
+        let (elsewhere, _) = tree_on_trunk(&shot, &camera, &image, Vec3::new(1.2, 0.0, 0.0));
+        assert!(
+            elsewhere < 0.3,
+            "frame {frame}: {:.0} % changed pixels where no tree stands",
+            elsewhere * 100.0
+        );
+        eyes.push(camera.position());
+    }
+    // Between the two screenshots the camera moved, and in both the tree stood on the
+    // projection of the ground origin and nowhere else.
+    let moved = eyes[0].distance(eyes[1]);
+    assert!(
+        moved > 0.3,
+        "the camera must move between the screenshots (moved {moved} m)"
+    );
+}
