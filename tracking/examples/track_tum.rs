@@ -58,8 +58,25 @@ fn main() {
 
 /// Diagnostic: orientation error relative to the first tracked frame, against ground truth.
 fn rotation_check(root: &str, report: &sylva_tracking::report::TrackReport) {
+    let steps = rotation_steps(root, report);
+    let mut sorted = steps.clone();
+    sorted.sort_by(|a, b| b.0.total_cmp(&a.0));
+    eprintln!(
+        "worst steps (err deg, frame, true step deg): {:?}",
+        &sorted[..sorted.len().min(15)]
+    );
+    let mean: f64 = steps.iter().map(|s| s.0).sum::<f64>() / steps.len().max(1) as f64;
+    eprintln!("mean step err {mean:.3} deg over {}", steps.len());
+}
+
+fn rotation_steps(
+    root: &str,
+    report: &sylva_tracking::report::TrackReport,
+) -> Vec<(f64, usize, f64)> {
     let seq = sylva_tracking::TumSequence::open(std::path::Path::new(root)).expect("sequence");
     let mut first: Option<(glam::DQuat, glam::DQuat)> = None;
+    let mut prev: Option<(glam::DQuat, glam::DQuat)> = None;
+    let mut steps = Vec::new();
     for row in &report.trajectory {
         let Some(q) = row.orientation else { continue };
         let Some(gt) = seq.groundtruth_at(row.timestamp_s, 0.02) else {
@@ -67,6 +84,19 @@ fn rotation_check(root: &str, report: &sylva_tracking::report::TrackReport) {
         };
         let est = glam::DQuat::from_array(q);
         let truth = glam::DQuat::from_mat3(&gt.matrix3);
+        if let Some((pe, pt)) = prev {
+            let step_err = (pe.inverse() * est)
+                .angle_between(pt.inverse() * truth)
+                .to_degrees();
+            steps.push((
+                step_err,
+                row.index,
+                (pt.inverse() * truth)
+                    .angle_between(glam::DQuat::IDENTITY)
+                    .to_degrees(),
+            ));
+        }
+        prev = Some((est, truth));
         let (e0, t0) = *first.get_or_insert((est, truth));
         let rel_est = e0.inverse() * est;
         let rel_truth = t0.inverse() * truth;
@@ -79,4 +109,5 @@ fn rotation_check(root: &str, report: &sylva_tracking::report::TrackReport) {
             );
         }
     }
+    steps
 }

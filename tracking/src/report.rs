@@ -53,6 +53,8 @@ pub struct TrackReport {
     pub num_map_points: usize,
     pub skipped: Vec<SkippedFrame>,
     pub scale_source: Option<crate::scale::ScaleSource>,
+    /// The ground plane in the world at the end of the run.
+    pub plane: Option<crate::frame::Plane>,
     /// Per frame: index, timestamp, state, `world_from_camera` translation (if tracked).
     pub trajectory: Vec<TrajectoryRow>,
     /// True positions of the tracked frames, aligned estimated positions (for plots).
@@ -208,6 +210,7 @@ fn summarise(
         num_map_points: tracker.map().points.len(),
         skipped,
         scale_source: tracker.world().map(|w| w.scale_source),
+        plane: tracker.world().map(|w| w.plane_in_world()),
         trajectory,
         aligned,
     }

@@ -29,13 +29,14 @@ pub struct TrackerConfig {
     pub max_tracks: usize,
     /// Minimum distance between corners, pixels. Default 14.
     pub min_corner_distance_px: f32,
-    /// Forward-backward Lucas–Kanade tolerance, pixels. Default 1.0.
+    /// Forward-backward Lucas–Kanade tolerance, pixels. Default 2.0.
     pub max_fb_error_px: f32,
-    /// Reprojection error beyond which a track is an outlier, pixels. Default 3.0.
+    /// Reprojection error beyond which a track is an outlier, pixels. Default 4.0.
     pub outlier_px: f64,
     /// Huber threshold δ for pose refinement and bundle adjustment, pixels. Default 1.5.
     pub huber_px: f64,
-    /// Smallest ray angle for triangulating a point, degrees. Default 1.0.
+    /// Smallest ray angle for triangulating a point, degrees. Default 0.5 (fr1_rpy is
+    /// mostly rotation: waiting for 1° starves the map).
     pub min_parallax_deg: f64,
     /// Median ray angle needed to initialise, degrees. Default 1.0.
     pub init_min_parallax_deg: f64,
@@ -60,10 +61,10 @@ impl Default for TrackerConfig {
         Self {
             max_tracks: 300,
             min_corner_distance_px: 14.0,
-            max_fb_error_px: 1.0,
-            outlier_px: 3.0,
+            max_fb_error_px: 2.0,
+            outlier_px: 4.0,
             huber_px: 1.5,
-            min_parallax_deg: 1.0,
+            min_parallax_deg: 0.5,
             init_min_parallax_deg: 1.0,
             init_min_points: 80,
             min_pose_inliers: 12,
@@ -232,20 +233,8 @@ impl Tracker {
                 kept.push(Track { pixel, ..*track });
             }
         }
-        let before = (
-            self.tracks.iter().filter(|t| t.point.is_some()).count(),
-            self.tracks.len(),
-        );
         self.tracks = kept;
-        let after_lk = self.tracks.iter().filter(|t| t.point.is_some()).count();
         let estimated = self.estimate_pose(predicted)?;
-        if std::env::var_os("SYLVA_TRACE").is_some() {
-            let after_pose = self.tracks.iter().filter(|t| t.point.is_some()).count();
-            eprintln!(
-                "frame {}: points {} tracks {} -> lk {} -> pose {}",
-                frame.index, before.0, before.1, after_lk, after_pose
-            );
-        }
         let Some(pose) = estimated else {
             return self.relocalise(frame);
         };
@@ -382,16 +371,6 @@ impl Tracker {
             .map(|m| normalized(&self.camera, m.2))
             .collect();
         let found = cv::pnp_ransac(&self.camera, &world, &image, None, 4.0)?;
-        if std::env::var_os("SYLVA_TRACE").is_some() {
-            eprintln!(
-                "reloc {}: described {} features {} matches {} inliers {:?}",
-                frame.index,
-                described.len(),
-                features.len(),
-                matches.len(),
-                found.as_ref().map(|f| f.1.len())
-            );
-        }
         let Some((pose, inliers)) = found else {
             return Ok(None);
         };
