@@ -159,21 +159,6 @@ fn add_leaf(mesh: &mut LitMesh, node: &Internode, angle: f32, ambient: f32) {
         .extend([base, base + 1, base + 2, base, base + 2, base + 3]);
 }
 
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    #[test]
-    fn the_standin_skeleton_is_a_valid_arena_and_deterministic() {
-        let a = standin_skeleton(3, 4);
-        a.sanity_check().expect("valid arena");
-        assert_eq!(a, standin_skeleton(3, 4));
-        assert!(a.len() > 20);
-        let mesh = standin_tree_mesh(&a);
-        assert!(!mesh.leaves.is_empty() && !mesh.branches.is_empty());
-    }
-}
-
 /// Stand-in for brush-guided growth (space colonization towards `attractors`): each attractor
 /// votes for the nearest internode end within `perception` metres; each node with votes grows one
 /// internode of `step` metres towards the mean of its voters; attractors closer than `kill` to a
@@ -308,5 +293,20 @@ pub fn standin_bend(skeleton: &mut Skeleton, root: NodeId, rotation: Quat) {
             node.end = pivot + rotation * (node.end - pivot);
             node.left = rotation * node.left;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_standin_skeleton_is_a_valid_arena_and_deterministic() {
+        let a = standin_skeleton(3, 4);
+        a.sanity_check().expect("valid arena");
+        assert_eq!(a, standin_skeleton(3, 4));
+        assert!(a.len() > 20);
+        let mesh = standin_tree_mesh(&a);
+        assert!(!mesh.leaves.is_empty() && !mesh.branches.is_empty());
     }
 }
