@@ -264,6 +264,7 @@ impl FrameSource for FileListSource {
 /// Decodes an image file to grey, checking its size against the camera.
 pub fn decode_gray(path: &Path, camera: &Camera) -> Result<GrayImage, String> {
     let bytes = std::fs::read(path).map_err(|e| e.to_string())?;
+    check_complete(&bytes)?;
     let decoded = image::load_from_memory(&bytes).map_err(|e| e.to_string())?;
     let gray = decoded.to_luma8();
     if gray.width() != camera.width || gray.height() != camera.height {
@@ -277,6 +278,20 @@ pub fn decode_gray(path: &Path, camera: &Camera) -> Result<GrayImage, String> {
     }
     let (width, height) = gray.dimensions();
     GrayImage::from_pixels(width, height, gray.into_raw()).ok_or_else(|| "bad pixel buffer".into())
+}
+
+/// Decoders accept cut-off JPEGs (grey below the cut); a complete JPEG ends with the EOI
+/// marker and a complete PNG with its IEND chunk.
+fn check_complete(bytes: &[u8]) -> Result<(), String> {
+    let is_jpeg = bytes.starts_with(&[0xFF, 0xD8]);
+    let is_png = bytes.starts_with(b"\x89PNG");
+    let tail = &bytes[bytes.len().saturating_sub(16)..];
+    let jpeg_end = tail.windows(2).any(|w| w == [0xFF, 0xD9]);
+    let png_end = tail.windows(4).any(|w| w == b"IEND");
+    if (is_jpeg && !jpeg_end) || (is_png && !png_end) {
+        return Err("truncated image file (no end marker)".into());
+    }
+    Ok(())
 }
 
 /// Decodes a 16-bit depth map to metres (0 where there is no measurement).
