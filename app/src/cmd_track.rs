@@ -1,0 +1,84 @@
+//! `sylva track SEQUENCE [--report report.json] [--plot trajectory.png]`: runs the monocular
+//! tracker over a recorded TUM-layout sequence, prints per-stage timings and ends with one
+//! `key=value` line (error fields only when the sequence has ground truth).
+
+use anyhow::Context;
+use std::path::PathBuf;
+
+#[derive(clap::Args, Debug)]
+pub struct TrackArgs {
+    /// A TUM-layout sequence folder (rgb.txt, camera.txt, optional groundtruth.txt, ...).
+    pub sequence: PathBuf,
+    /// Writes the full report (metrics, timings, per-frame trajectory) as JSON.
+    #[arg(long)]
+    pub report: Option<PathBuf>,
+    /// Draws the aligned estimated trajectory over the true one (top view) as a PNG.
+    #[arg(long)]
+    pub plot: Option<PathBuf>,
+    /// Height the camera is held at above the ground, metres (sets the metric scale).
+    #[arg(long, default_value_t = 1.5)]
+    pub holding_height_m: f64,
+}
+
+#[cfg(any(target_os = "android", target_os = "ios"))]
+pub fn track(_args: TrackArgs) -> anyhow::Result<()> {
+    anyhow::bail!("`sylva track` needs the OpenCV tracker, which phone builds leave out")
+}
+
+#[cfg(not(any(target_os = "android", target_os = "ios")))]
+pub fn track(args: TrackArgs) -> anyhow::Result<()> {
+    use indicatif::{ProgressBar, ProgressStyle};
+    use sylva_tracking::report::run_sequence;
+
+    let config = sylva_tracking::TrackerConfig {
+        holding_height_m: args.holding_height_m,
+        ..Default::default()
+    };
+    let bar = ProgressBar::new(0);
+    bar.set_style(
+        ProgressStyle::with_template("{bar:40} {pos}/{len} frames {elapsed_precise} {msg}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
+    let report = run_sequence(
+        &args.sequence,
+        config,
+        |done, total| {
+            bar.set_length(total as u64);
+            bar.set_position(done as u64);
+        },
+        |skip| {
+            bar.println(format!(
+                "warning: skipped frame {}: {}",
+                skip.path.display(),
+                skip.reason
+            ))
+        },
+    )
+    .with_context(|| format!("tracking {}", args.sequence.display()))?;
+    bar.finish_and_clear();
+    println!(
+        "stage decode: median {:.2} ms/frame (excluded from ms_per_frame)",
+        report.median_decode_ms
+    );
+    println!(
+        "stage track: median {:.2} ms/frame (features, pose, local map, keyframes, bundle adjustment)",
+        report.ms_per_frame
+    );
+    println!(
+        "map: {} keyframes, {} points; scale from {:?}; {} frames skipped",
+        report.num_keyframes,
+        report.num_map_points,
+        report.scale_source,
+        report.skipped.len()
+    );
+    if let Some(path) = &args.report {
+        let json = serde_json::to_string_pretty(&report).context("encoding the report")?;
+        std::fs::write(path, json).with_context(|| format!("writing {}", path.display()))?;
+    }
+    if let Some(path) = &args.plot {
+        crate::track_plot::draw(&report, path)
+            .with_context(|| format!("drawing {}", path.display()))?;
+    }
+    println!("{}", report.summary_line());
+    Ok(())
+}
