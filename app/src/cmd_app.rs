@@ -76,7 +76,7 @@ pub fn demo() -> anyhow::Result<()> {
     absolute.save(&session_path)?;
     let report = replay(&session_path, Some(&out), true, |_, _| {})?;
     println!(
-        "rendered {} frames of the demo to {}/frame_0000.png … (tree in {}/tree.json)",
+        "rendered {} frames of the demo to {}/frame_0000.png … (tree in {}/tree.json and tree.glb)",
         report.num_frames,
         out.display(),
         out.display()

@@ -36,6 +36,7 @@ pub fn demo_session(footage: &Footage, footage_ref: PathBuf) -> anyhow::Result<S
         let top_pixel = state.camera.and_then(|c| {
             let top = state
                 .tree
+                .skeleton
                 .internodes
                 .iter()
                 .map(|i| i.end)
@@ -49,7 +50,7 @@ pub fn demo_session(footage: &Footage, footage_ref: PathBuf) -> anyhow::Result<S
                 events.push(touch(TouchPhase::Start, 0, p));
             }
         } else if step > at(0.1) && step < at(0.3) {
-            stroke_pixel += Vec2::new(1.5, -2.5);
+            stroke_pixel += Vec2::new(3.0, -5.0);
             events.push(touch(TouchPhase::Move, 0, stroke_pixel));
         } else if step == at(0.3) {
             events.push(touch(TouchPhase::End, 0, stroke_pixel));
@@ -61,7 +62,7 @@ pub fn demo_session(footage: &Footage, footage_ref: PathBuf) -> anyhow::Result<S
             stroke_pixel = p;
             events.push(touch(TouchPhase::Start, 0, p));
         } else if step > at(0.35) && step < at(0.55) {
-            stroke_pixel += Vec2::new(-2.0, -2.0);
+            stroke_pixel += Vec2::new(-4.0, -4.0);
             events.push(touch(TouchPhase::Move, 0, stroke_pixel));
             if step == at(0.45) {
                 let mut p = state.params.clone();
@@ -73,7 +74,8 @@ pub fn demo_session(footage: &Footage, footage_ref: PathBuf) -> anyhow::Result<S
         }
         // Prune: double tap on the newest branch.
         if (step == at(0.62) || step == at(0.62) + 1)
-            && let (Some(camera), Some(newest)) = (state.camera, state.tree.internodes.last())
+            && let (Some(camera), Some(newest)) =
+                (state.camera, state.tree.skeleton.internodes.last())
             && let Some(p) = camera.pixel_from_world(0.5 * (newest.start + newest.end))
         {
             events.push(touch(TouchPhase::Start, 0, p));
@@ -82,7 +84,11 @@ pub fn demo_session(footage: &Footage, footage_ref: PathBuf) -> anyhow::Result<S
         // Bend: three fingers around a branch half way up, dragged to the right.
         if step == at(0.7)
             && let Some(camera) = state.camera
-            && let Some(node) = state.tree.internodes.get(state.tree.len() / 2)
+            && let Some(node) = state
+                .tree
+                .skeleton
+                .internodes
+                .get(state.tree.skeleton.len() / 2)
             && let Some(p) = camera.pixel_from_world(node.end)
         {
             bend_pixel = p;

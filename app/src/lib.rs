@@ -6,7 +6,6 @@
 pub mod cli;
 pub mod cmd_grow;
 pub mod render;
-pub mod standin;
 pub mod tree_model;
 pub mod footage;
 pub mod state;

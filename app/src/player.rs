@@ -125,11 +125,18 @@ impl Player {
     }
 }
 
-/// Writes the tree as `tree.json` (and `.glb` once glTF export is available) into `dir`.
+/// Writes the tree as `tree.json` (the growth state) and `tree.glb` (its meshes) into `dir`;
+/// returns the path of the `.glb`.
 pub fn export_tree(design: &DesignState, dir: &Path) -> anyhow::Result<PathBuf> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
-    let path = dir.join("tree.json");
-    std::fs::write(&path, serde_json::to_vec_pretty(&design.tree)?)
-        .with_context(|| format!("cannot write {}", path.display()))?;
-    Ok(path)
+    let json = dir.join("tree.json");
+    design
+        .tree
+        .save(&json)
+        .with_context(|| format!("cannot write {}", json.display()))?;
+    let glb = dir.join("tree.glb");
+    let meshes = sylva_core::geometry::build_tree_meshes(&design.tree);
+    sylva_core::export::write_glb(&meshes, &glb)
+        .with_context(|| format!("cannot write {}", glb.display()))?;
+    Ok(glb)
 }

@@ -140,7 +140,7 @@ pub fn frame_camera(record: &FrameRecord, footage: &Footage) -> Option<ViewCamer
     ))
 }
 
-/// Replays `session` (located at `session_path`); writes PNG frames and the tree into `out` when
+/// Replays `session` (located at `session_path`); writes PNG frames and the tree (`tree.json`, `tree.glb`) into `out` when
 /// given, and renders frames when `render` is set.
 pub fn replay(
     session_path: &Path,
@@ -210,9 +210,7 @@ pub fn replay(
     let num_frames = session.frames.len();
     let ms_per_frame = started.elapsed().as_secs_f64() * 1000.0 / num_frames.max(1) as f64;
     if let Some(out) = out {
-        let path = out.join("tree.json");
-        std::fs::write(&path, serde_json::to_vec_pretty(&state.tree)?)
-            .with_context(|| format!("cannot write {}", path.display()))?;
+        crate::player::export_tree(&state, out)?;
     }
     Ok(ReplayReport {
         tree_sha256: state.tree_sha256(),

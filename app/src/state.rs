@@ -13,10 +13,14 @@ use std::collections::BTreeMap;
 
 use glam::{Quat, Vec2, Vec3};
 use serde::{Deserialize, Serialize};
-use sylva_core::{NodeId, Rng, Skeleton};
+use sylva_core::edit::{
+    Bend, BendSettings, BrushPlane, BrushSettings, BrushStroke, History, OperationKind,
+    PositionalConstraint, Timeline, prune_at,
+};
+use sylva_core::species::Species;
+use sylva_core::{NodeId, Tree};
 
 use crate::render::ViewCamera;
-use crate::standin;
 
 /// Growth and brush parameters the UI exposes.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -43,29 +47,81 @@ pub struct Parameters {
 
 impl Default for Parameters {
     fn default() -> Self {
+        match Species::by_name(DEFAULT_SPECIES) {
+            Ok(species) => Parameters::for_species(&species),
+            Err(_) => Parameters::for_species(&Species::presets()[0]),
+        }
+    }
+}
+
+/// The species a new design starts with.
+pub const DEFAULT_SPECIES: &str = "maple";
+
+impl Parameters {
+    /// The parameters of a species preset, with the default brush.
+    pub fn for_species(species: &Species) -> Parameters {
         Parameters {
-            species: "generic".into(),
-            apical_dominance: 0.5,
-            light_sensitivity: 0.5,
-            shedding_threshold: 0.2,
-            max_shoot_length: 3,
-            direction_weights: [0.2, 0.7, 0.1],
-            tropism_angle: 0.0,
-            gravimorphism: [1.0, 1.0],
-            branching_angle: 0.7,
-            deflection_angle: 0.1,
+            species: species.name.clone(),
+            apical_dominance: species.apical_dominance,
+            light_sensitivity: species.light_sensitivity,
+            shedding_threshold: species.shedding_threshold,
+            max_shoot_length: species.max_shoot_internodes.round().max(1.0) as u32,
+            direction_weights: normalised_weights([
+                species.straightness,
+                species.environment_weight,
+                species.tropism_weight,
+            ]),
+            tropism_angle: species.gravitropism_angle_deg.to_radians(),
+            gravimorphism: [
+                species.gravimorphism.parallel_semi_axis,
+                species.gravimorphism.vertical_semi_axis,
+            ],
+            branching_angle: species.branching_angle_deg.to_radians(),
+            deflection_angle: species.deflection_angle_deg.to_radians(),
             years: 5.0,
             brush_radius: 0.12,
             grow_speed: 10.0,
         }
     }
+
+    /// Writes the growth parameters into `species` (α, β, γ are the straightness, environment
+    /// and tropism weights of the shoot direction).
+    pub fn apply_to(&self, species: &mut Species) {
+        species.apical_dominance = self.apical_dominance;
+        species.light_sensitivity = self.light_sensitivity;
+        species.shedding_threshold = self.shedding_threshold;
+        species.max_shoot_internodes = self.max_shoot_length.max(1) as f32;
+        let [alpha, beta, gamma] = self.direction_weights;
+        species.straightness = alpha;
+        species.environment_weight = beta;
+        species.tropism_weight = gamma;
+        species.gravitropism_angle_deg = self.tropism_angle.to_degrees();
+        species.gravimorphism.parallel_semi_axis = self.gravimorphism[0];
+        species.gravimorphism.vertical_semi_axis = self.gravimorphism[1];
+        species.branching_angle_deg = self.branching_angle.to_degrees();
+        species.deflection_angle_deg = self.deflection_angle.to_degrees();
+    }
 }
 
-impl Parameters {
-    /// The tropism direction (unit) from θ.
-    pub fn tropism(&self) -> Vec3 {
-        Vec3::new(self.tropism_angle.sin(), self.tropism_angle.cos(), 0.0)
+fn normalised_weights(w: [f32; 3]) -> [f32; 3] {
+    let sum: f32 = w.iter().sum();
+    if sum > 0.0 {
+        w.map(|x| x / sum)
+    } else {
+        [1.0 / 3.0; 3]
     }
+}
+
+/// The species preset named `name`, or the default species for an unknown name.
+pub fn species_named(name: &str) -> Species {
+    Species::by_name(name)
+        .or_else(|_| Species::by_name(DEFAULT_SPECIES))
+        .unwrap_or_else(|_| Species::presets().swap_remove(0))
+}
+
+/// Names of the species presets, for the picker.
+pub fn species_names() -> Vec<String> {
+    Species::presets().into_iter().map(|s| s.name).collect()
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -124,20 +180,31 @@ const DOUBLE_TAP_S: f64 = 0.35;
 const HOLD_S: f64 = 0.5;
 const PICK_RADIUS_PX: f32 = 25.0;
 
+/// A three-finger bend in progress: the branch from `base` to its tip `end`, rotated about the
+/// start of `base` by `angle` radians about the view direction.
+struct BendGesture {
+    bend: Bend,
+    end: NodeId,
+    pivot: Vec3,
+    rest_end: Vec3,
+    angle: f32,
+    last: Vec2,
+}
+
 /// The tree being designed and everything that edits it.
 pub struct DesignState {
     pub params: Parameters,
-    pub tree: Skeleton,
+    pub tree: Tree,
     pub seed: u64,
-    history: Vec<Skeleton>,
+    history: History,
+    timeline: Timeline,
     pub stroke: Option<Stroke>,
+    brush: Option<BrushStroke>,
     pub finished_strokes: Vec<Stroke>,
-    attractors: Vec<Vec3>,
-    rng: Rng,
     touches: BTreeMap<u64, Touch>,
     last_tap: Option<(f64, Vec2)>,
     pub selected: Option<NodeId>,
-    bend: Option<(NodeId, Vec2)>,
+    bend: Option<BendGesture>,
     pub camera: Option<ViewCamera>,
     pub time_s: f64,
     /// Bumped whenever the tree changes (the renderer re-meshes on change).
@@ -145,18 +212,37 @@ pub struct DesignState {
     grow_debt: f32,
 }
 
+/// Autonomous iterations of the sapling a design starts from: a trunk with a few laterals to
+/// brush from.
+pub const PLANTED_ITERATIONS: u32 = 1;
+
+fn planted(species: Species, seed: u64) -> Tree {
+    let mut tree = Tree::new(species, seed);
+    tree.grow(PLANTED_ITERATIONS, None);
+    tree
+}
+
+/// Undo steps kept.
+const MAX_UNDO: usize = 64;
+
 impl DesignState {
-    /// A seedling at the ground origin.
+    /// A sapling of `params.species` (the default species for an unknown name) at the ground
+    /// origin: its seedling grown [`PLANTED_ITERATIONS`] autonomous iterations.
     pub fn new(seed: u64, params: Parameters) -> DesignState {
+        let mut species = species_named(&params.species);
+        params.apply_to(&mut species);
+        let tree = planted(species, seed);
+        let mut timeline = Timeline::default();
+        timeline.keep(&tree);
         DesignState {
             params,
-            tree: standin::standin_skeleton(seed, 0),
+            tree,
             seed,
-            history: Vec::new(),
+            history: History::new(MAX_UNDO),
+            timeline,
             stroke: None,
+            brush: None,
             finished_strokes: Vec::new(),
-            attractors: Vec::new(),
-            rng: Rng::new(seed ^ 0x5eed),
             touches: BTreeMap::new(),
             last_tap: None,
             selected: None,
@@ -170,29 +256,23 @@ impl DesignState {
 
     /// Number of undo steps available.
     pub fn undo_depth(&self) -> usize {
-        self.history.len()
-    }
-
-    fn checkpoint(&mut self) {
-        self.history.push(self.tree.clone());
-        if self.history.len() > 64 {
-            self.history.remove(0);
-        }
+        self.history.num_undoable()
     }
 
     fn changed(&mut self) {
         self.revision += 1;
     }
 
-    /// SHA-256 of the tree's JSON.
+    /// SHA-256 of the tree's JSON file.
     pub fn tree_sha256(&self) -> String {
         use sha2::Digest;
-        let json = serde_json::to_vec(&self.tree).unwrap_or_default();
+        let json = self.tree.to_json_bytes().unwrap_or_default();
         format!("{:x}", sha2::Sha256::digest(json))
     }
 
     /// Advances to a new frame seen from `camera` at `time_s`: the brush plane follows the
-    /// device, held touches become selections, and the tree grows towards the brush.
+    /// device, held touches become selections, and while a stroke is painted the tree grows
+    /// towards it (brush-guided iterations, `grow_speed` per second).
     pub fn advance_frame(&mut self, camera: Option<ViewCamera>, time_s: f64, dt_s: f32) {
         self.camera = camera;
         self.time_s = time_s;
@@ -203,35 +283,35 @@ impl DesignState {
         self.grow_debt += self.params.grow_speed.max(0.0) * dt_s;
         while self.grow_debt >= 1.0 {
             self.grow_debt -= 1.0;
-            if !self.attractors.is_empty() {
+            if self.brush.is_some() {
                 self.grow_once();
             }
         }
     }
 
-    fn grow_once(&mut self) -> usize {
-        let grown = standin::standin_grow_towards(
-            &mut self.tree,
-            &mut self.attractors,
-            (0.45, 0.05),
-            self.params.direction_weights,
-            self.params.tropism(),
-        );
-        if grown > 0 {
+    /// One brush-guided growth iteration towards the persistent points of the stroke.
+    fn grow_once(&mut self) {
+        let Some(brush) = self.brush.as_mut() else {
+            return;
+        };
+        brush.emit_dab(&mut self.tree);
+        let stats = brush.iterate(&mut self.tree);
+        self.timeline.keep(&self.tree);
+        if stats.num_new_internodes > 0 {
             self.changed();
         }
-        grown
     }
 
     /// Applies one input event.
     pub fn apply(&mut self, event: &InputEvent) {
         match event {
             InputEvent::Touch { phase, id, x, y } => self.touch(*phase, *id, Vec2::new(*x, *y)),
-            InputEvent::Parameters { parameters } => self.params = parameters.clone(),
+            InputEvent::Parameters { parameters } => self.set_parameters(parameters),
             InputEvent::Undo => {
-                if let Some(previous) = self.history.pop() {
-                    self.tree = previous;
-                    self.attractors.clear();
+                if self.history.undo(&mut self.tree).is_some() {
+                    self.brush = None;
+                    self.bend = None;
+                    self.selected = None;
                     self.changed();
                 }
             }
@@ -239,41 +319,58 @@ impl DesignState {
         }
     }
 
-    fn grow_whole_tree(&mut self, iterations: i32) {
-        self.checkpoint();
-        if iterations < 0 {
-            for _ in 0..iterations.unsigned_abs() {
-                let newest = self.tree.internodes.iter().map(|n| n.born_iteration).max();
-                let Some(newest) = newest.filter(|n| *n > 0) else {
-                    break;
-                };
-                while let Some(i) = self
-                    .tree
-                    .internodes
-                    .iter()
-                    .rposition(|n| n.born_iteration == newest && i_is_not_root(n))
-                {
-                    standin::standin_remove_subtree(&mut self.tree, NodeId(i as u32));
-                }
-            }
-        } else {
-            let top = self
-                .tree
-                .internodes
-                .iter()
-                .map(|n| n.end)
-                .fold(Vec3::ZERO, |a, b| if b.y > a.y { b } else { a });
-            for _ in 0..iterations {
-                for _ in 0..24 {
-                    let p =
-                        top + Vec3::Y * 0.2 + self.rng.in_unit_ball() * Vec3::new(0.5, 0.35, 0.5);
-                    self.attractors.push(p);
-                }
-                self.grow_once();
-            }
-            self.attractors.clear();
+    /// New parameters (undoable). Another species starts a seedling of it.
+    fn set_parameters(&mut self, parameters: &Parameters) {
+        if *parameters == self.params {
+            return;
         }
-        self.changed();
+        self.history.record(OperationKind::Parameters, &self.tree);
+        if parameters.species != self.tree.species.name {
+            let species = species_named(&parameters.species);
+            let brush = (parameters.brush_radius, parameters.grow_speed);
+            self.params = Parameters {
+                brush_radius: brush.0,
+                grow_speed: brush.1,
+                ..Parameters::for_species(&species)
+            };
+            self.tree = planted(species, self.seed);
+            self.timeline = Timeline::default();
+            self.timeline.keep(&self.tree);
+            self.brush = None;
+            self.changed();
+            return;
+        }
+        self.params = parameters.clone();
+        parameters.apply_to(&mut self.tree.species);
+    }
+
+    /// Autonomous growth (positive) or ungrowing to an earlier kept iteration (negative).
+    fn grow_whole_tree(&mut self, iterations: i32) {
+        let result = if iterations >= 0 {
+            let n = iterations as u32;
+            let timeline = &mut self.timeline;
+            self.history
+                .perform(OperationKind::Grow, &mut self.tree, |tree| {
+                    for _ in 0..n {
+                        tree.grow(1, None);
+                        timeline.keep(tree);
+                    }
+                    Ok(())
+                })
+        } else {
+            let target = self
+                .tree
+                .iteration
+                .saturating_sub(iterations.unsigned_abs());
+            let timeline = &self.timeline;
+            self.history
+                .perform(OperationKind::Grow, &mut self.tree, |tree| {
+                    timeline.go_to(tree, target)
+                })
+        };
+        if result.is_ok() {
+            self.changed();
+        }
     }
 
     fn touch(&mut self, phase: TouchPhase, id: u64, pixel: Vec2) {
@@ -330,11 +427,8 @@ impl DesignState {
         };
         // A stroke starting on a branch takes that branch's depth, else the tree's.
         let depth = match self.pick(pixel) {
-            Some(id) => camera.depth_of(self.tree.get(id).end),
-            None => {
-                let centre = self.tree_centre();
-                camera.depth_of(centre)
-            }
+            Some(id) => camera.depth_of(self.tree.skeleton.get(id).end),
+            None => camera.depth_of(self.tree_centre()),
         };
         if depth <= camera.near {
             return;
@@ -349,26 +443,24 @@ impl DesignState {
     }
 
     fn tree_centre(&self) -> Vec3 {
-        let n = self.tree.len().max(1) as f32;
-        self.tree.internodes.iter().map(|i| i.end).sum::<Vec3>() / n
+        let nodes = &self.tree.skeleton.internodes;
+        let n = nodes.len().max(1) as f32;
+        nodes.iter().map(|i| i.end).sum::<Vec3>() / n
     }
 
-    /// Adds the finger's point on the brush plane seen from the current camera.
+    /// Adds the finger's point on the brush plane seen from the current camera; the first
+    /// point starts an undoable `sylva_core` brush stroke on the plane facing the camera.
     fn add_stroke_point(&mut self) {
         let (Some(camera), Some(stroke)) = (self.camera, self.stroke.as_mut()) else {
             return;
         };
         let moved = self.touches.values().any(|t| t.moved);
-        if !moved
-            && stroke.points.is_empty()
-            && self.time_s
-                - self
-                    .touches
-                    .values()
-                    .map(|t| t.start_time_s)
-                    .fold(f64::MAX, f64::min)
-                < HOLD_S
-        {
+        let first_touch_s = self
+            .touches
+            .values()
+            .map(|t| t.start_time_s)
+            .fold(f64::MAX, f64::min);
+        if !moved && stroke.points.is_empty() && self.time_s - first_touch_s < HOLD_S {
             // Not yet a stroke: maybe a tap.
             return;
         }
@@ -376,20 +468,32 @@ impl DesignState {
         let point = camera
             .world_from_camera
             .transform_point3(ray * stroke.depth);
-        if stroke.points.is_empty() {
-            self.history.push(self.tree.clone());
-        }
         let radius = self.params.brush_radius;
         stroke.points.push(point);
         stroke.radii.push(radius);
         stroke.eyes.push(camera.position());
-        for _ in 0..6 {
-            let p = point + self.rng.in_unit_ball() * radius;
-            self.attractors.push(p);
+        if self.brush.is_none() {
+            let facing = camera.position() - point;
+            let Ok(plane) = BrushPlane::new(point, facing) else {
+                return;
+            };
+            self.history.record(OperationKind::Stroke, &self.tree);
+            self.brush = Some(BrushStroke::new(plane, BrushSettings::default()));
+        }
+        let time_s = self.time_s;
+        if let Some(brush) = self.brush.as_mut() {
+            let time_s = brush
+                .points()
+                .last()
+                .map_or(time_s, |p| p.time_s.max(time_s));
+            if brush.add_point(time_s, point, radius).is_ok() {
+                brush.emit(&mut self.tree);
+            }
         }
     }
 
     fn end_stroke(&mut self, keep: bool) {
+        self.brush = None;
         if let Some(stroke) = self.stroke.take()
             && keep
             && !stroke.points.is_empty()
@@ -398,6 +502,7 @@ impl DesignState {
         }
     }
 
+    /// A double tap prunes the branch under the finger (`sylva_core::edit::prune_at`).
     fn tap(&mut self, pixel: Vec2) {
         let double = self
             .last_tap
@@ -407,9 +512,18 @@ impl DesignState {
             return;
         }
         self.last_tap = None;
-        if let Some(id) = self.pick(pixel).filter(|id| id.0 != 0) {
-            self.checkpoint();
-            standin::standin_remove_subtree(&mut self.tree, id);
+        let Some(id) = self.pick(pixel) else {
+            return;
+        };
+        let node = self.tree.skeleton.get(id);
+        let point = 0.5 * (node.start + node.end);
+        let pruned = self
+            .history
+            .perform(OperationKind::Prune, &mut self.tree, |tree| {
+                prune_at(tree, point)
+            });
+        if pruned.is_ok() {
+            self.timeline.keep(&self.tree);
             self.selected = None;
             self.changed();
         }
@@ -431,28 +545,57 @@ impl DesignState {
         }
     }
 
+    /// Three fingers on a branch start bending it (`sylva_core::edit::Bend`) from the picked
+    /// internode up to the tip of its axis.
     fn begin_bend(&mut self) {
         self.end_stroke(false);
         let centroid = self.touch_centroid();
-        if let Some(id) = self
+        let Some(base) = self
             .pick_within(centroid, 4.0 * PICK_RADIUS_PX)
             .filter(|id| id.0 != 0)
-        {
-            self.checkpoint();
-            self.bend = Some((id, centroid));
-        }
-    }
-
-    fn update_bend(&mut self) {
-        let (Some((root, last)), Some(camera)) = (self.bend, self.camera) else {
+        else {
             return;
         };
+        let skeleton = &self.tree.skeleton;
+        let mut end = base;
+        while let Some(next) = skeleton.get(end).main_child {
+            end = next;
+        }
+        let Ok(bend) = Bend::new(skeleton, base, end, BendSettings::default()) else {
+            return;
+        };
+        let pivot = skeleton.get(base).start;
+        let rest_end = skeleton.get(end).end;
+        self.history.record(OperationKind::Bend, &self.tree);
+        self.bend = Some(BendGesture {
+            bend,
+            end,
+            pivot,
+            rest_end,
+            angle: 0.0,
+            last: centroid,
+        });
+    }
+
+    /// Sideways finger motion turns the branch tip about the view direction.
+    fn update_bend(&mut self) {
         let centroid = self.touch_centroid();
-        let angle = (centroid.x - last.x) / 200.0;
+        let (Some(gesture), Some(camera)) = (self.bend.as_mut(), self.camera) else {
+            return;
+        };
+        gesture.angle += (centroid.x - gesture.last.x) / 200.0;
+        gesture.last = centroid;
         let forward = camera.world_from_camera.z_axis.truncate();
-        standin::standin_bend(&mut self.tree, root, Quat::from_axis_angle(forward, -angle));
-        self.bend = Some((root, centroid));
-        self.changed();
+        let rotation = Quat::from_axis_angle(forward, -gesture.angle);
+        let target = gesture.pivot + rotation * (gesture.rest_end - gesture.pivot);
+        let constraint = PositionalConstraint {
+            node: gesture.end,
+            end_position: target,
+        };
+        if let Ok(pose) = gesture.bend.solve(&[constraint]) {
+            gesture.bend.apply_to_tree(&pose, &mut self.tree);
+            self.changed();
+        }
     }
 
     fn touch_centroid(&self) -> Vec2 {
@@ -468,6 +611,7 @@ impl DesignState {
     fn pick_within(&self, pixel: Vec2, radius_px: f32) -> Option<NodeId> {
         let camera = self.camera?;
         self.tree
+            .skeleton
             .internodes
             .iter()
             .enumerate()
@@ -479,8 +623,4 @@ impl DesignState {
             .min_by(|a, b| a.1.total_cmp(&b.1))
             .map(|(i, _)| NodeId(i as u32))
     }
-}
-
-fn i_is_not_root(n: &sylva_core::Internode) -> bool {
-    n.parent.is_some()
 }

@@ -1,30 +1,36 @@
-//! The tree the app shows and edits, and the meshes drawn for it.
-//!
-//! Until `sylva_core`'s growth and geometry land, the skeleton and mesh come from the clearly
-//! named stand-ins in [`crate::standin`].
+//! The tree the app shows and edits, and the meshes drawn for it: `sylva_core`'s growth and
+//! `sylva_core::geometry` meshes (finest level of detail, per-vertex ambient light from the
+//! growth shadow grid), converted to the renderer's vertices.
 
 use glam::Vec3;
-use sylva_core::Skeleton;
+use sylva_core::geometry::{TreeMeshes, build_tree_meshes};
+use sylva_core::{Skeleton, Tree};
 
-use crate::render::TreeMesh;
-use crate::standin::{standin_skeleton, standin_tree_mesh};
+use crate::render::{LitMesh, LitVertex, TreeMesh};
+use crate::state::species_named;
 
 /// Seed of the tree in the golden images.
 pub const GOLDEN_SEED: u64 = 7;
+/// Species of the tree in the golden images.
+pub const GOLDEN_SPECIES: &str = "maple";
+/// Autonomous growth iterations of the golden-image tree.
+pub const GOLDEN_ITERATIONS: u32 = 8;
 
-/// The skeleton of the golden-image tree.
-pub fn golden_skeleton() -> Skeleton {
-    standin_skeleton(GOLDEN_SEED, 5)
+/// The golden-image tree: a young maple grown autonomously.
+pub fn golden_tree() -> Tree {
+    let mut tree = Tree::new(species_named(GOLDEN_SPECIES), GOLDEN_SEED);
+    tree.grow(GOLDEN_ITERATIONS, None);
+    tree
 }
 
 /// The mesh of the golden-image tree.
 pub fn golden_tree_mesh() -> TreeMesh {
-    standin_tree_mesh(&golden_skeleton())
+    mesh_of(&golden_tree())
 }
 
 /// The point of the golden tree's trunk at height `h` (metres above its base).
 pub fn golden_trunk_point(h: f32) -> Vec3 {
-    trunk_point(&golden_skeleton(), h)
+    trunk_point(&golden_tree().skeleton, h)
 }
 
 /// The point of the trunk (the main axis from the root) at height `h`, or its top when the
@@ -50,7 +56,35 @@ pub fn trunk_point(skeleton: &Skeleton, h: f32) -> Vec3 {
     }
 }
 
-/// The mesh drawn for a skeleton.
-pub fn mesh_of(skeleton: &Skeleton) -> TreeMesh {
-    standin_tree_mesh(skeleton)
+/// The mesh drawn for a tree: bark and alpha-cut leaves of the finest level of detail.
+pub fn mesh_of(tree: &Tree) -> TreeMesh {
+    draw_mesh(&build_tree_meshes(tree))
+}
+
+/// The renderer's mesh of `sylva_core` meshes (level 0). Leaf texture coordinates go from
+/// the core's (u across 0..1, v from tip 0 to petiole 1) to the renderer's (x across −½..½,
+/// y from petiole 0 to tip 1).
+pub fn draw_mesh(meshes: &TreeMeshes) -> TreeMesh {
+    let branches = meshes
+        .lods
+        .first()
+        .map(|lod| lit(&lod.branches, |uv| uv))
+        .unwrap_or_default();
+    let leaves = lit(&meshes.leaves, |[u, v]| [u - 0.5, 1.0 - v]);
+    TreeMesh { branches, leaves }
+}
+
+fn lit(mesh: &sylva_core::geometry::TreeMesh, uv_of: impl Fn([f32; 2]) -> [f32; 2]) -> LitMesh {
+    let vertices = (0..mesh.positions.len())
+        .map(|i| LitVertex {
+            position: mesh.positions[i],
+            normal: mesh.normals[i],
+            ambient: mesh.ambient[i],
+            uv: uv_of(mesh.uvs[i]),
+        })
+        .collect();
+    LitMesh {
+        vertices,
+        indices: mesh.indices.clone(),
+    }
 }

@@ -57,7 +57,7 @@ fn the_committed_demo_session_replays_to_the_committed_tree_and_frames() {
     let out = tempfile::tempdir().expect("temp dir");
     let mut sizes = Vec::new();
     let report = replay(&session_path, Some(out.path()), true, |_, state| {
-        sizes.push(state.tree.len())
+        sizes.push(state.tree.skeleton.len())
     })
     .expect("replay");
     assert!(out.path().join("frame_0000.png").exists() && out.path().join("tree.json").exists());

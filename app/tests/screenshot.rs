@@ -80,13 +80,19 @@ fn screenshot(display: &str, frame: usize, dir: &Path) -> RgbaImage {
     image::open(&path).expect("screenshot").to_rgba8()
 }
 
-/// The trunk of the seedling the app plants at the ground origin, at height `h`.
-fn seedling_trunk(h: f32) -> Vec3 {
+/// The trunk of the sapling the app plants at the ground origin, at `fraction` of its height.
+fn seedling_trunk(fraction: f32) -> Vec3 {
     let design = sylva_app::state::DesignState::new(
         sylva_app::player::DEFAULT_SEED,
         sylva_app::state::Parameters::default(),
     );
-    sylva_app::tree_model::trunk_point(&design.tree, h)
+    let skeleton = &design.tree.skeleton;
+    let top = skeleton
+        .internodes
+        .iter()
+        .map(|n| n.end.y)
+        .fold(0.0, f32::max);
+    sylva_app::tree_model::trunk_point(skeleton, fraction * top)
 }
 
 /// Window pixel of a world point seen from `camera`, as the renderer letterboxes it.
@@ -112,7 +118,7 @@ fn tree_on_trunk(
     let region = letterbox(WINDOW, &camera.intrinsics);
     let (mut num_samples, mut num_tree) = (0, 0);
     for i in 1..16 {
-        let Some(p) = window_pixel(camera, base + seedling_trunk(i as f32 * 0.04)) else {
+        let Some(p) = window_pixel(camera, base + seedling_trunk(i as f32 / 16.0)) else {
             continue;
         };
         if !(100.0..980.0).contains(&p.x) || !(40.0..660.0).contains(&p.y) {

@@ -102,7 +102,7 @@ fn dragging_the_weights_triangle_keeps_the_sum_one_and_changes_growth() {
     });
     brush_stroke(&mut changed);
     assert!(
-        default_design.tree.len() > 6,
+        default_design.tree.skeleton.len() > 6,
         "the stroke must grow the tree"
     );
     assert_ne!(
@@ -160,17 +160,17 @@ fn the_brush_radius_slider_changes_the_radius_in_the_middle_of_a_stroke() {
 #[test]
 fn undo_restores_the_previous_tree() {
     let mut h = harness(app());
-    let before = h.state().design.tree.clone();
+    let before = h.state().design.tree.skeleton.clone();
     h.state_mut()
         .design
         .apply(&InputEvent::Grow { iterations: 2 });
     assert_ne!(
-        h.state().design.tree,
+        h.state().design.tree.skeleton,
         before,
         "growing must change the tree"
     );
     h.run();
     h.get_by_label("Undo").click();
     h.run();
-    assert_eq!(h.state().design.tree, before);
+    assert_eq!(h.state().design.tree.skeleton, before);
 }

@@ -60,7 +60,7 @@ impl Default for UiState {
             budget: FrameBudget::default(),
             show_debug: false,
             export_requested: false,
-            species_names: vec!["generic".into()],
+            species_names: crate::state::species_names(),
         }
     }
 }
