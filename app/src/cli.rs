@@ -19,6 +19,8 @@ pub enum Command {
     Replay(crate::cmd_app::ReplayArgs),
     /// Opens a window on a recorded sequence (or `--camera N`).
     View(crate::cmd_app::ViewArgs),
+    /// Tracks a recorded sequence; prints timings and a key=value accuracy line.
+    Track(crate::cmd_track::TrackArgs),
 }
 
 pub fn main() -> anyhow::Result<()> {
@@ -28,6 +30,7 @@ pub fn main() -> anyhow::Result<()> {
         Some(Command::Grow(args)) => crate::cmd_grow::grow(args),
         Some(Command::Replay(args)) => crate::cmd_app::replay_command(args),
         Some(Command::View(args)) => crate::cmd_app::view(args),
+        Some(Command::Track(args)) => crate::cmd_track::track(args),
         None => crate::cmd_app::demo(),
     }
 }

@@ -22,6 +22,12 @@ pub struct GrowArgs {
     /// Where to save the grown tree (versioned JSON).
     #[arg(long)]
     pub out: PathBuf,
+    /// Also export the tree's meshes (three levels of detail, leaves, textures) as binary glTF 2.0.
+    #[arg(long)]
+    pub glb: Option<PathBuf>,
+    /// Also export the finest level of detail as Wavefront OBJ + MTL, textures next to it.
+    #[arg(long)]
+    pub obj: Option<PathBuf>,
 }
 
 /// Prints one line per preset, starting with its name.
@@ -68,10 +74,30 @@ pub fn grow(args: GrowArgs) -> anyhow::Result<()> {
     tree.grow_years(args.years);
     let elapsed_ms = started.elapsed().as_secs_f64() * 1000.0;
     tree.save(&args.out)?;
+    export_meshes(&tree, args.glb.as_deref(), args.obj.as_deref())?;
     let m = tree.metrics();
     println!(
         "internodes={} height_m={:.3} crown_width_m={:.3} trunk_diameter_m={:.4} elapsed_ms={:.1}",
         m.num_internodes, m.height_m, m.crown_width_m, m.trunk_diameter_m, elapsed_ms
     );
+    Ok(())
+}
+
+/// Writes the `--glb` and `--obj` files, if asked for, one line each (before the summary line,
+/// which stays the last line of the output).
+fn export_meshes(tree: &Tree, glb: Option<&Path>, obj: Option<&Path>) -> anyhow::Result<()> {
+    if glb.is_none() && obj.is_none() {
+        return Ok(());
+    }
+    let meshes = sylva_core::geometry::build_tree_meshes(tree);
+    let triangles = [0, 1, 2].map(|lod| meshes.num_triangles(lod));
+    if let Some(path) = glb {
+        sylva_core::export::write_glb(&meshes, path)?;
+        println!("glb={} lod_triangles={:?}", path.display(), triangles);
+    }
+    if let Some(path) = obj {
+        sylva_core::export::write_obj(&meshes, path)?;
+        println!("obj={} triangles={}", path.display(), triangles[0]);
+    }
     Ok(())
 }

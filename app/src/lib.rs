@@ -4,14 +4,17 @@
 //! UI, sessions and the command line.
 
 pub mod cli;
-pub mod cmd_grow;
-pub mod render;
-pub mod tree_model;
-pub mod footage;
-pub mod state;
-pub mod session;
-pub mod ui;
-pub mod desktop;
-pub mod player;
 pub mod cmd_app;
+pub mod cmd_grow;
+pub mod cmd_track;
 pub mod demo_script;
+pub mod desktop;
+pub mod footage;
+pub mod player;
+pub mod render;
+pub mod session;
+pub mod state;
+#[cfg(not(any(target_os = "android", target_os = "ios")))]
+pub mod track_plot;
+pub mod tree_model;
+pub mod ui;

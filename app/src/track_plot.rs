@@ -4,9 +4,12 @@ use plotters::prelude::*;
 use std::path::Path;
 use sylva_tracking::report::TrackReport;
 
+/// A polyline in plot coordinates (metres).
+type Polyline = Vec<(f64, f64)>;
+
 /// Draws the plot; without ground truth, the estimated positions alone.
 pub fn draw(report: &TrackReport, path: &Path) -> anyhow::Result<()> {
-    let (truth, estimate): (Vec<(f64, f64)>, Vec<(f64, f64)>) = if report.aligned.is_empty() {
+    let (truth, estimate): (Polyline, Polyline) = if report.aligned.is_empty() {
         let est = report
             .trajectory
             .iter()

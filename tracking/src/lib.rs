@@ -32,9 +32,9 @@ mod initializer;
 #[cfg(feature = "opencv")]
 mod mapping;
 #[cfg(feature = "opencv")]
-pub mod tracker;
-#[cfg(feature = "opencv")]
 pub mod report;
+#[cfg(feature = "opencv")]
+pub mod tracker;
 
 pub use camera::{Camera, CameraError};
 pub use frame::{Frame, FrameOutput, GrayImage, Plane, TrackedPoint, TrackingState};
