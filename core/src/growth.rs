@@ -84,7 +84,8 @@ pub struct TreeMetrics {
 }
 
 /// Per-iteration working memory, kept between iterations so the hot loops do not allocate.
-#[derive(Clone, Debug, Default)]
+/// Cloning a tree (undo history, what-if previews) does not copy it: a clone starts empty.
+#[derive(Debug, Default)]
 pub(crate) struct Scratch {
     pub buds: Vec<buds::BudState>,
     /// Buds of node i are `buds[node_bud_start[i]..node_bud_start[i + 1]]`, terminal first.
@@ -94,6 +95,8 @@ pub(crate) struct Scratch {
     pub node_grid: crate::environment::SpatialGrid,
     pub point_grid: crate::environment::SpatialGrid,
     pub point_alive: Vec<bool>,
+    /// Index in `buds` of each entry of `bud_grid` (the buds competing this iteration).
+    pub competing: Vec<u32>,
     pub q_main: Vec<f32>,
     pub q_lateral: Vec<f32>,
     pub vigor: Vec<f32>,
@@ -101,6 +104,12 @@ pub(crate) struct Scratch {
     pub in_mask: Vec<bool>,
     pub acc: Vec<f64>,
     pub subtree_root: Vec<u32>,
+}
+
+impl Clone for Scratch {
+    fn clone(&self) -> Self {
+        Scratch::default()
+    }
 }
 
 impl Tree {

@@ -189,20 +189,24 @@ impl Skeleton {
             });
         }
         remap.resize(self.internodes.len(), None);
-        let old = std::mem::take(&mut self.internodes);
-        self.internodes.reserve(next as usize);
-        for (i, mut node) in old.into_iter().enumerate() {
-            if remap[i].is_none() {
+        // Compact in place: a kept node only moves towards the front, so the arena is rewritten
+        // in one pass without a second allocation.
+        let mut write = 0;
+        for (read, kept) in remap.iter().enumerate() {
+            if kept.is_none() {
                 continue;
             }
+            self.internodes.swap(write, read);
+            let node = &mut self.internodes[write];
             node.parent = node.parent.and_then(|p| remap[p.index()]);
             node.main_child = node.main_child.and_then(|c| remap[c.index()]);
             node.lateral_children.retain(|c| remap[c.index()].is_some());
             for c in &mut node.lateral_children {
                 *c = remap[c.index()].unwrap_or(*c);
             }
-            self.internodes.push(node);
+            write += 1;
         }
+        self.internodes.truncate(write);
         remap
     }
 

@@ -88,9 +88,7 @@ impl SpatialGrid {
     }
 
     fn cell_coord(&self, p: Vec3) -> IVec3 {
-        ((p - self.origin) * self.inv_cell_size)
-            .floor()
-            .as_ivec3()
+        floor_to_ivec3((p - self.origin) * self.inv_cell_size)
             .clamp(IVec3::ZERO, self.dims - IVec3::ONE)
     }
 
@@ -118,12 +116,8 @@ impl SpatialGrid {
             return false;
         }
         let r2 = radius * radius;
-        let lo = ((center - Vec3::splat(radius) - self.origin) * self.inv_cell_size)
-            .floor()
-            .as_ivec3();
-        let hi = ((center + Vec3::splat(radius) - self.origin) * self.inv_cell_size)
-            .floor()
-            .as_ivec3();
+        let lo = floor_to_ivec3((center - Vec3::splat(radius) - self.origin) * self.inv_cell_size);
+        let hi = floor_to_ivec3((center + Vec3::splat(radius) - self.origin) * self.inv_cell_size);
         if hi.cmplt(IVec3::ZERO).any() || lo.cmpge(self.dims).any() {
             return false;
         }
@@ -148,6 +142,14 @@ impl SpatialGrid {
     }
 }
 
+/// ⌊v⌋ per component without a libm call (x86-64's baseline has no SSE4.1 `roundps`, so
+/// `f32::floor` is a function call in the hot query loops). Saturates like `as`, NaN gives 0.
+#[inline]
+pub(crate) fn floor_to_ivec3(v: Vec3) -> IVec3 {
+    let t = v.as_ivec3();
+    t - IVec3::select(v.cmplt(t.as_vec3()), IVec3::ONE, IVec3::ZERO)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -169,6 +171,14 @@ mod tests {
                 .filter(|&i| points[i as usize].distance_squared(center) <= radius * radius)
                 .collect();
             assert_eq!(found, expected);
+        }
+    }
+
+    #[test]
+    fn fast_floor_matches_floor() {
+        for x in [-2.5f32, -2.0, -1e-7, 0.0, 1e-7, 0.999, 1.0, 3.5, -0.5] {
+            let v = Vec3::new(x, -x, x * 3.0);
+            assert_eq!(floor_to_ivec3(v), v.floor().as_ivec3(), "{v}");
         }
     }
 

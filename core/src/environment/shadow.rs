@@ -7,22 +7,38 @@
 //!
 //! Values are fixed-point integers, so adding and removing nodes in any order gives exactly the
 //! same grid: incremental updates during growth, a rebuild after loading and an "ungrow" all agree
-//! bit for bit. The grid is dense over a box that grows (with slack) as the tree does.
+//! bit for bit. Voxels live in 8³ bricks allocated where shade falls (see [`ShadowGrid`]).
 
 use glam::{IVec3, Vec3};
 
 /// Fixed-point scale of shadow values: 1.0 of shadow = 65 536 units.
 const UNITS_PER_SHADOW: f32 = 65_536.0;
+/// Voxels per brick edge (a power of two); bricks are 8³ voxels, x fastest.
+const BRICK_SHIFT: i32 = 3;
+const BRICK: i32 = 1 << BRICK_SHIFT;
+const BRICK_VOXELS: usize = (BRICK * BRICK * BRICK) as usize;
+/// Marks a brick-index cell that has no brick yet.
+const NO_BRICK: u32 = u32::MAX;
+/// Bricks are stored in chunks of this many, so adding one never moves the others.
+const BRICKS_PER_CHUNK: usize = 64;
 
+/// Shadow values in bricks of 8³ voxels, allocated on first touch and found through a dense
+/// index over brick coordinates. Growing the crown only grows the small index; bricks never move,
+/// so the cost of adding a node is its pyramid alone, whatever the size of the tree.
 #[derive(Clone, Debug, Default)]
 pub struct ShadowGrid {
     voxel_size: f32,
     /// Δs per pyramid level q, in fixed-point units.
     level_units: Vec<i32>,
-    /// Voxel coordinates of `values[0]`.
-    min_voxel: IVec3,
-    dims: IVec3,
-    values: Vec<i32>,
+    /// Brick coordinates of `brick_of[0]`.
+    min_brick: IVec3,
+    brick_dims: IVec3,
+    /// Index into `values` (in bricks) of each brick cell, or [`NO_BRICK`].
+    brick_of: Vec<u32>,
+    /// Brick after brick in chunks of [`BRICKS_PER_CHUNK`], each brick 8³ values with x
+    /// fastest, then y, then z.
+    chunks: Vec<Box<[i32]>>,
+    num_bricks: usize,
 }
 
 impl ShadowGrid {
@@ -34,9 +50,7 @@ impl ShadowGrid {
         ShadowGrid {
             voxel_size: voxel_size.max(1e-4),
             level_units,
-            min_voxel: IVec3::ZERO,
-            dims: IVec3::ZERO,
-            values: Vec::new(),
+            ..ShadowGrid::default()
         }
     }
 
@@ -46,24 +60,49 @@ impl ShadowGrid {
 
     /// Number of voxels currently allocated.
     pub fn num_voxels(&self) -> usize {
-        self.values.len()
+        self.num_bricks * BRICK_VOXELS
+    }
+
+    /// The values of brick `brick`.
+    fn brick_values(&self, brick: usize) -> &[i32] {
+        let start = (brick % BRICKS_PER_CHUNK) * BRICK_VOXELS;
+        &self.chunks[brick / BRICKS_PER_CHUNK][start..start + BRICK_VOXELS]
+    }
+
+    fn brick_values_mut(&mut self, brick: usize) -> &mut [i32] {
+        let start = (brick % BRICKS_PER_CHUNK) * BRICK_VOXELS;
+        &mut self.chunks[brick / BRICKS_PER_CHUNK][start..start + BRICK_VOXELS]
     }
 
     fn voxel_of(&self, point_in_world: Vec3) -> IVec3 {
-        (point_in_world / self.voxel_size).floor().as_ivec3()
+        super::grid::floor_to_ivec3(point_in_world / self.voxel_size)
     }
 
-    /// Shadow value s at a point (0 outside the grid).
+    /// Index in `brick_of` of brick coordinates `b`, if inside the index box.
+    fn brick_cell(&self, b: IVec3) -> Option<usize> {
+        let o = b - self.min_brick;
+        if o.cmplt(IVec3::ZERO).any() || o.cmpge(self.brick_dims).any() {
+            return None;
+        }
+        Some((o.x + self.brick_dims.x * (o.y + self.brick_dims.y * o.z)) as usize)
+    }
+
+    /// Shadow value s at a point (0 where no node casts shade).
     pub fn shadow_at(&self, point_in_world: Vec3) -> f32 {
         if !point_in_world.is_finite() {
             return 0.0;
         }
-        let v = self.voxel_of(point_in_world) - self.min_voxel;
-        if v.cmplt(IVec3::ZERO).any() || v.cmpge(self.dims).any() {
+        let v = self.voxel_of(point_in_world);
+        let Some(cell) = self.brick_cell(v >> BRICK_SHIFT) else {
+            return 0.0;
+        };
+        let brick = self.brick_of[cell];
+        if brick == NO_BRICK {
             return 0.0;
         }
-        let i = (v.x + self.dims.x * (v.y + self.dims.y * v.z)) as usize;
-        self.values[i] as f32 / UNITS_PER_SHADOW
+        let local = v & (BRICK - 1);
+        let i = (local.x + BRICK * (local.y + BRICK * local.z)) as usize;
+        self.brick_values(brick as usize)[i] as f32 / UNITS_PER_SHADOW
     }
 
     /// Adds (`sign` = 1) or removes (`sign` = −1) the shadow pyramid of a node.
@@ -73,60 +112,87 @@ impl ShadowGrid {
         }
         let q_max = (self.level_units.len() - 1) as i32;
         let top = self.voxel_of(node_in_world);
-        self.ensure_covers(
-            top - IVec3::new(q_max, q_max, q_max),
-            top + IVec3::new(q_max, 0, q_max),
-        );
+        let lo = top - IVec3::splat(q_max);
+        let hi = top + IVec3::new(q_max, 0, q_max);
+        self.ensure_index_covers(lo >> BRICK_SHIFT, hi >> BRICK_SHIFT);
         for q in 0..=q_max {
             let delta = sign * self.level_units[q as usize];
-            let y = top.y - q - self.min_voxel.y;
-            for z in (top.z - q - self.min_voxel.z)..=(top.z + q - self.min_voxel.z) {
-                let row = (self.dims.x * (y + self.dims.y * z)) as usize;
-                let x0 = (top.x - q - self.min_voxel.x) as usize;
-                let x1 = (top.x + q - self.min_voxel.x) as usize;
-                for value in &mut self.values[row + x0..=row + x1] {
-                    *value += delta;
-                }
+            let y = top.y - q;
+            for z in (top.z - q)..=(top.z + q) {
+                self.add_to_row(top.x - q, top.x + q, y, z, delta);
             }
         }
     }
 
-    /// Grows the dense box (with 50% slack per side) so that `lo..=hi` voxels are inside it.
-    fn ensure_covers(&mut self, lo: IVec3, hi: IVec3) {
-        let cur_hi = self.min_voxel + self.dims - IVec3::ONE;
-        if !self.values.is_empty() && lo.cmpge(self.min_voxel).all() && hi.cmple(cur_hi).all() {
+    /// Adds `delta` to voxels x0..=x1 of row (y, z), one contiguous run per brick.
+    fn add_to_row(&mut self, x0: i32, x1: i32, y: i32, z: i32, delta: i32) {
+        let (by, bz) = (y >> BRICK_SHIFT, z >> BRICK_SHIFT);
+        let row_offset = BRICK * ((y & (BRICK - 1)) + BRICK * (z & (BRICK - 1)));
+        let mut x = x0;
+        while x <= x1 {
+            let bx = x >> BRICK_SHIFT;
+            let run_end = x1.min((bx << BRICK_SHIFT) + BRICK - 1);
+            let brick = self.brick_at(IVec3::new(bx, by, bz));
+            let base = (row_offset + (x & (BRICK - 1))) as usize;
+            let len = (run_end - x + 1) as usize;
+            for value in &mut self.brick_values_mut(brick)[base..base + len] {
+                *value += delta;
+            }
+            x = run_end + 1;
+        }
+    }
+
+    /// The brick at brick coordinates `b` (inside the index box), allocated if missing.
+    fn brick_at(&mut self, b: IVec3) -> usize {
+        let Some(cell) = self.brick_cell(b) else {
+            unreachable!("ensure_index_covers runs before every brick access");
+        };
+        if self.brick_of[cell] == NO_BRICK {
+            if self.num_bricks == self.chunks.len() * BRICKS_PER_CHUNK {
+                self.chunks
+                    .push(vec![0; BRICKS_PER_CHUNK * BRICK_VOXELS].into_boxed_slice());
+            }
+            self.brick_of[cell] = self.num_bricks as u32;
+            self.num_bricks += 1;
+        }
+        self.brick_of[cell] as usize
+    }
+
+    /// Grows the brick index so that bricks `lo..=hi` are inside it, with slack of half the
+    /// extent (at least 2 bricks) on every side that overflows.
+    fn ensure_index_covers(&mut self, lo: IVec3, hi: IVec3) {
+        let cur_hi = self.min_brick + self.brick_dims - IVec3::ONE;
+        if !self.brick_of.is_empty() && lo.cmpge(self.min_brick).all() && hi.cmple(cur_hi).all() {
             return;
         }
-        let (new_lo, new_hi) = if self.values.is_empty() {
-            (lo - IVec3::splat(8), hi + IVec3::splat(8))
+        let (new_lo, new_hi) = if self.brick_of.is_empty() {
+            (lo - IVec3::splat(2), hi + IVec3::splat(2))
         } else {
-            let slack = (self.dims / 2).max(IVec3::splat(8));
-            let want_lo = lo.min(self.min_voxel);
-            let want_hi = hi.max(cur_hi);
+            let slack = (self.brick_dims / 2).max(IVec3::splat(2));
             (
-                IVec3::select(lo.cmplt(self.min_voxel), want_lo - slack, want_lo),
-                IVec3::select(hi.cmpgt(cur_hi), want_hi + slack, want_hi),
+                IVec3::select(lo.cmplt(self.min_brick), lo - slack, self.min_brick),
+                IVec3::select(hi.cmpgt(cur_hi), hi + slack, cur_hi),
             )
         };
         let new_dims = new_hi - new_lo + IVec3::ONE;
-        let mut values = vec![0; (new_dims.x * new_dims.y * new_dims.z) as usize];
-        for z in 0..self.dims.z {
-            for y in 0..self.dims.y {
-                let src = (self.dims.x * (y + self.dims.y * z)) as usize;
-                let o = self.min_voxel + IVec3::new(0, y, z) - new_lo;
+        let mut brick_of = vec![NO_BRICK; (new_dims.x * new_dims.y * new_dims.z) as usize];
+        for z in 0..self.brick_dims.z {
+            for y in 0..self.brick_dims.y {
+                let src = (self.brick_dims.x * (y + self.brick_dims.y * z)) as usize;
+                let o = self.min_brick + IVec3::new(0, y, z) - new_lo;
                 let dst = (o.x + new_dims.x * (o.y + new_dims.y * o.z)) as usize;
-                values[dst..dst + self.dims.x as usize]
-                    .copy_from_slice(&self.values[src..src + self.dims.x as usize]);
+                let n = self.brick_dims.x as usize;
+                brick_of[dst..dst + n].copy_from_slice(&self.brick_of[src..src + n]);
             }
         }
-        self.values = values;
-        self.min_voxel = new_lo;
-        self.dims = new_dims;
+        self.brick_of = brick_of;
+        self.min_brick = new_lo;
+        self.brick_dims = new_dims;
     }
 
     /// True when every voxel is zero (no node casts shade).
     pub fn is_clear(&self) -> bool {
-        self.values.iter().all(|&v| v == 0)
+        self.chunks.iter().all(|c| c.iter().all(|&v| v == 0))
     }
 }
 
@@ -148,5 +214,44 @@ mod tests {
         grid.apply_node(node, -1);
         grid.apply_node(Vec3::new(5.0, 9.0, -3.0), -1);
         assert!(grid.is_clear());
+    }
+
+    #[test]
+    fn pyramids_across_brick_borders_and_negative_coordinates_sum_exactly() {
+        // Brute force over a dense box: the pyramid formula, summed over nodes.
+        let (a, b, q_max, voxel) = (1.0f32, 1.5f32, 5i32, 0.1f32);
+        let mut grid = ShadowGrid::new(voxel, a, b, q_max as u32);
+        let nodes = [
+            Vec3::new(-0.75, 0.35, 0.05),
+            Vec3::new(0.05, 1.25, -0.65),
+            Vec3::new(0.79, -0.41, 0.81),
+            Vec3::new(-0.05, 0.75, -0.05),
+        ];
+        for n in nodes {
+            grid.apply_node(n, 1);
+        }
+        for x in -16..16 {
+            for y in -16..16 {
+                for z in -16..16 {
+                    let v = IVec3::new(x, y, z);
+                    let expected: i32 = nodes
+                        .iter()
+                        .map(|n| {
+                            let top = (*n / voxel).floor().as_ivec3();
+                            let q = top.y - y;
+                            let p = (x - top.x).abs().max((z - top.z).abs());
+                            if (0..=q_max).contains(&q) && p <= q {
+                                (a * b.powi(-q) * UNITS_PER_SHADOW).round() as i32
+                            } else {
+                                0
+                            }
+                        })
+                        .sum();
+                    let at = (v.as_vec3() + Vec3::splat(0.5)) * voxel;
+                    let got = grid.shadow_at(at);
+                    assert_eq!((got * UNITS_PER_SHADOW).round() as i32, expected, "{v}");
+                }
+            }
+        }
     }
 }

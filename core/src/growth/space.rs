@@ -16,6 +16,9 @@ use super::{Scratch, StepOptions, Tree};
 use crate::environment::{AttractionPoints, SceneMode};
 use crate::rng::Rng;
 
+/// Cell size of the bud grid relative to the perception radius.
+const PERCEPTION_CELL_FRACTION: f32 = 0.5;
+
 /// Radii of the model in metres: (occupancy r, perception r + d, cos(ζ/2)).
 pub(crate) fn radii(tree: &Tree) -> (f32, f32, f32) {
     let s = &tree.species;
@@ -57,12 +60,20 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
             .iter()
             .map(|p| !scratch.node_grid.any_within(p.position, r)),
     );
-    // Perception: each surviving point feeds its closest perceiving bud.
+    // Perception: each surviving point feeds its closest perceiving bud. Only competing buds
+    // enter the grid; cells of half the perception radius keep the scanned volume near the
+    // sphere's.
     scratch.positions.clear();
+    scratch.competing.clear();
+    for (i, bud) in scratch.buds.iter().enumerate() {
+        if bud.competes {
+            scratch.positions.push(bud.position);
+            scratch.competing.push(i as u32);
+        }
+    }
     scratch
-        .positions
-        .extend(scratch.buds.iter().map(|b| b.position));
-    scratch.bud_grid.rebuild(&scratch.positions, perception);
+        .bud_grid
+        .rebuild(&scratch.positions, PERCEPTION_CELL_FRACTION * perception);
     let mut alive_count = 0;
     for (point, &alive) in points.iter().zip(&scratch.point_alive) {
         if !alive {
@@ -70,15 +81,17 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
         }
         alive_count += 1;
         let mut best: Option<(u32, f32)> = None;
-        let buds = &scratch.buds;
+        let (buds, competing) = (&scratch.buds, &scratch.competing);
         scratch
             .bud_grid
-            .for_each_within(point.position, perception, |bi, bud_pos, d2| {
-                let bud = &buds[bi as usize];
-                if !bud.competes || best.is_some_and(|(_, bd)| bd <= d2) {
+            .for_each_within(point.position, perception, |ci, bud_pos, d2| {
+                if best.is_some_and(|(_, bd)| bd <= d2) {
                     return;
                 }
-                if (point.position - bud_pos).dot(bud.direction) >= cos_half * d2.sqrt() {
+                let bi = competing[ci as usize];
+                if (point.position - bud_pos).dot(buds[bi as usize].direction)
+                    >= cos_half * d2.sqrt()
+                {
                     best = Some((bi, d2));
                 }
             });
