@@ -382,8 +382,14 @@ impl OrbFeatures {
     ) -> Result<Vec<Option<Descriptor>>> {
         let mut keypoints: Vector<KeyPoint> = Vector::new();
         for (i, p) in points.iter().enumerate() {
+            // ORB takes provided keypoints' angles as they are: give each the intensity-centroid
+            // orientation detection would have found, or its descriptor would not match the
+            // same corner detected in another frame.
+            let Some(angle) = intensity_centroid_angle_deg(image, *p) else {
+                continue;
+            };
             keypoints.push(KeyPoint::new_coords(
-                p.x, p.y, 31.0, -1.0, 0.0, 0, i as i32,
+                p.x, p.y, 31.0, angle, 0.0, 0, i as i32,
             )?);
         }
         let descriptors = self.run(image, &mut keypoints, true)?;
@@ -395,6 +401,32 @@ impl OrbFeatures {
         }
         Ok(out)
     }
+}
+
+/// Radius of ORB's orientation patch (half its 31-pixel patch).
+const ORIENTATION_RADIUS: i32 = 15;
+
+/// Orientation of the intensity centroid (Rosin's moments m₁₀, m₀₁ over a disc of radius 15
+/// around `p`), in degrees in [0, 360) as ORB measures it. None too near the border.
+fn intensity_centroid_angle_deg(image: &GrayImage, p: Vec2) -> Option<f32> {
+    let (cx, cy) = (p.x.round() as i32, p.y.round() as i32);
+    let (w, h) = (image.width as i32, image.height as i32);
+    let r = ORIENTATION_RADIUS;
+    if cx < r || cy < r || cx + r >= w || cy + r >= h {
+        return None;
+    }
+    let (mut m10, mut m01) = (0i64, 0i64);
+    for v in -r..=r {
+        let half = ((r * r - v * v) as f32).sqrt().round() as i32;
+        let row = ((cy + v) * w) as usize;
+        for u in -half..=half {
+            let value = i64::from(image.pixels[row + (cx + u) as usize]);
+            m10 += i64::from(u) * value;
+            m01 += i64::from(v) * value;
+        }
+    }
+    let angle = (m01 as f32).atan2(m10 as f32).to_degrees();
+    Some(if angle < 0.0 { angle + 360.0 } else { angle })
 }
 
 /// Hamming distance between two ORB descriptors.
