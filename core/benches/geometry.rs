@@ -1,6 +1,14 @@
-//! Meshing benchmarks: branches at three levels of detail, leaves and fruit of synthetic
-//! branching skeletons of 1k, 10k and 100k internodes. Target (one core): the 100k-internode
-//! tree with leaves in ≤ 50 ms. Also the GLB encoding of the 10k tree.
+//! Meshing benchmarks on synthetic branching skeletons of 1k, 10k and 100k internodes, with
+//! leaves and fruit.
+//!
+//! - `mesh_drawn_level`: the finest level of detail (the one the app draws) plus the leaf and
+//!   fruit buffers, as the app re-meshes after an edit. Issue #4's target (one core): the
+//!   100k-internode tree in ≤ 50 ms.
+//! - `mesh_all_levels`: all three levels of detail plus leaves and fruit, as the glTF export
+//!   builds them.
+//!
+//! Each with fresh buffers and with a [`Mesher`] and output meshes reused from the previous
+//! call. Also the GLB encoding of the 10k tree.
 
 use std::hint::black_box;
 
@@ -8,40 +16,63 @@ use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::Vec3;
 use sylva_core::export::glb_bytes;
 use sylva_core::geometry::synthetic::{branching_skeleton, crown_ambient};
-use sylva_core::geometry::{FruitParams, MeshParams, TreeMeshes, build_meshes, build_meshes_into};
+use sylva_core::geometry::{
+    FruitParams, Levels, MeshParams, Mesher, TreeMeshes, build_level, build_meshes,
+};
 
 const SEED: u64 = 7;
 
-fn meshing(c: &mut Criterion) {
-    let params = MeshParams {
+fn params() -> MeshParams {
+    MeshParams {
         fruit: Some(FruitParams::default()),
         ..MeshParams::default()
-    };
-    let ambient = crown_ambient(Vec3::new(0.0, 1.5, 0.0), 2.0);
-    let mut group = c.benchmark_group("build_meshes");
-    group.sample_size(20);
-    for num_internodes in [1_000, 10_000, 100_000] {
-        let skeleton = branching_skeleton(num_internodes, SEED);
-        let meshes = build_meshes(&skeleton, &params, &ambient);
-        println!(
-            "{num_internodes} internodes: {} leaves, LOD triangles {} / {} / {}",
-            meshes.leaves.num_triangles() / 2,
-            meshes.num_triangles(0),
-            meshes.num_triangles(1),
-            meshes.num_triangles(2)
-        );
-        group.throughput(Throughput::Elements(num_internodes as u64));
-        group.bench_function(format!("{num_internodes}_internodes_with_leaves"), |b| {
-            b.iter(|| black_box(build_meshes(black_box(&skeleton), &params, &ambient)))
-        });
-        // Interactive re-meshing: the buffers of the previous mesh are reused.
-        let mut reused = TreeMeshes::default();
-        group.bench_function(
-            format!("{num_internodes}_internodes_with_leaves_reusing_buffers"),
-            |b| b.iter(|| build_meshes_into(black_box(&skeleton), &params, &ambient, &mut reused)),
-        );
     }
-    group.finish();
+}
+
+fn meshing(c: &mut Criterion) {
+    let params = params();
+    let ambient = crown_ambient(Vec3::new(0.0, 1.5, 0.0), 2.0);
+    for (group_name, levels) in [
+        ("mesh_drawn_level", Levels::One(0)),
+        ("mesh_all_levels", Levels::All),
+    ] {
+        let mut group = c.benchmark_group(group_name);
+        group.sample_size(20);
+        for num_internodes in [1_000, 10_000, 100_000] {
+            let skeleton = branching_skeleton(num_internodes, SEED);
+            let meshes = build_meshes(&skeleton, &params, &ambient);
+            println!(
+                "{num_internodes} internodes: {} leaves, LOD triangles {} / {} / {}",
+                meshes.leaves.num_triangles() / 2,
+                meshes.num_triangles(0),
+                meshes.num_triangles(1),
+                meshes.num_triangles(2)
+            );
+            group.throughput(Throughput::Elements(num_internodes as u64));
+            let name = match levels {
+                Levels::One(_) => format!("{num_internodes}_internodes_level0_with_leaves"),
+                Levels::All => format!("{num_internodes}_internodes_3_lods_with_leaves"),
+            };
+            group.bench_function(&name, |b| {
+                b.iter(|| match levels {
+                    Levels::One(level) => {
+                        black_box(build_level(black_box(&skeleton), &params, &ambient, level))
+                    }
+                    Levels::All => black_box(build_meshes(black_box(&skeleton), &params, &ambient)),
+                })
+            });
+            // Interactive re-meshing: working memory and output buffers of the previous call
+            // are reused.
+            let mut mesher = Mesher::new();
+            let mut reused = TreeMeshes::default();
+            group.bench_function(format!("{name}_reusing_buffers"), |b| {
+                b.iter(|| {
+                    mesher.build_into(black_box(&skeleton), &params, &ambient, levels, &mut reused)
+                })
+            });
+        }
+        group.finish();
+    }
 
     let skeleton = branching_skeleton(10_000, SEED);
     let meshes = build_meshes(&skeleton, &params, &ambient);

@@ -35,6 +35,8 @@ struct ChainRings {
     num_rings: u32,
     /// Sides C at the finest level (eq. C.2).
     sides: u32,
+    /// Diameter of the chain's first internode.
+    base_diameter: f32,
     /// Bark tiles around the circumference.
     tiles_around: f32,
     /// The parent's surface where a lateral chain starts; `None` for the trunk.
@@ -43,7 +45,9 @@ struct ChainRings {
 
 /// cos/sin of `k·2π/C` for k in 0..=C, and the indices of the 2C triangles joining two rings
 /// (relative to the first vertex of the lower ring), for every side count C up to a maximum.
+#[derive(Default)]
 struct SideTables {
+    max_sides: u32,
     offsets: Vec<usize>,
     cos_sin: Vec<(f32, f32)>,
     pattern_offsets: Vec<usize>,
@@ -70,6 +74,7 @@ impl SideTables {
             }
         }
         SideTables {
+            max_sides,
             offsets,
             cos_sin,
             pattern_offsets,
@@ -88,11 +93,14 @@ impl SideTables {
     }
 }
 
+/// Ring frames of every chain, and the working memory of the level-of-detail budget.
+#[derive(Default)]
 pub(crate) struct RingFrames {
     rings: Vec<Ring>,
     chains: Vec<ChainRings>,
-    /// Chains sorted by base diameter, thickest first (parents before children on ties).
-    order_by_diameter: Vec<u32>,
+    /// Chains keyed by base diameter, thickest first (parents before children on ties): the
+    /// chain index in the low 32 bits. Sorted on demand by the coarser levels.
+    by_diameter: Vec<u64>,
     tables: SideTables,
 }
 
@@ -212,12 +220,14 @@ fn transport(reference: Vec3, from: Vec3, from_tangent: Vec3, to: Vec3, to_tange
 }
 
 impl RingFrames {
-    pub(crate) fn build(
+    /// The rings of every chain of `topology`, into `self` (buffers reused).
+    pub(crate) fn build_into(
+        &mut self,
         nodes: &[NodeGeom],
         topology: &BranchTopology,
         params: &MeshParams,
         ambient: AmbientFn,
-    ) -> Self {
+    ) {
         let thinnest = nodes
             .iter()
             .map(|n| n.diameter)
@@ -225,11 +235,18 @@ impl RingFrames {
             .fold(f32::INFINITY, f32::min)
             .clamp(1e-4, 1.0);
         let max_sides = params.max_sides.max(3);
-        let mut rings = Vec::with_capacity(nodes.len() + topology.chains.len());
-        let mut chains = Vec::with_capacity(topology.chains.len());
+        if self.tables.max_sides != max_sides {
+            self.tables = SideTables::new(max_sides);
+        }
+        let (rings, chains) = (&mut self.rings, &mut self.chains);
+        rings.clear();
+        rings.reserve(nodes.len() + topology.chains.len());
+        chains.clear();
+        chains.reserve(topology.chains.len());
         for (chain_index, chain) in topology.chains.iter().enumerate() {
             let chain_nodes = topology.nodes_of(chain_index);
-            let base_diameter = nodes[chain_nodes[0] as usize].diameter.max(1e-5);
+            let raw_diameter = nodes[chain_nodes[0] as usize].diameter;
+            let base_diameter = raw_diameter.max(1e-5);
             let circumference = PI * base_diameter;
             let tiles_around = (circumference / params.bark_tile_size.max(1e-4))
                 .round()
@@ -238,7 +255,7 @@ impl RingFrames {
             let tube = (chain.parent_node != NONE)
                 .then(|| ParentTube::new(nodes, topology, chain.parent_node, params.tip_taper));
             push_chain_rings(
-                &mut rings,
+                rings,
                 nodes,
                 tube.as_ref(),
                 chain_nodes,
@@ -250,27 +267,12 @@ impl RingFrames {
                 first_ring,
                 num_rings: rings.len() as u32 - first_ring,
                 sides: contour_sides(base_diameter, thinnest, params.side_exponent, max_sides),
+                base_diameter: raw_diameter,
                 tiles_around,
                 tube,
             });
         }
-        let mut keyed: Vec<u64> = topology
-            .chains
-            .iter()
-            .enumerate()
-            .map(|(index, chain)| {
-                let diameter = nodes[topology.chain_nodes[chain.first as usize] as usize].diameter;
-                // Non-negative floats order as their bits; invert for thickest first.
-                (u64::from(u32::MAX - diameter.max(0.0).to_bits()) << 32) | index as u64
-            })
-            .collect();
-        keyed.sort_unstable();
-        RingFrames {
-            rings,
-            chains,
-            order_by_diameter: keyed.into_iter().map(|k| k as u32).collect(),
-            tables: SideTables::new(max_sides),
-        }
+        self.by_diameter.clear();
     }
 
     /// Triangles of the branches drawn with `side_scale` of the finest sides, all chains or the
@@ -287,15 +289,27 @@ impl RingFrames {
     /// The thickest chains whose triangles, with `side_scale`, fit in `budget`; a chain is only
     /// kept with its parent, and the trunk always.
     pub(crate) fn chains_within_budget(
-        &self,
+        &mut self,
         topology: &BranchTopology,
         side_scale: f32,
         budget: usize,
-    ) -> Vec<bool> {
-        let mut kept = vec![false; self.chains.len()];
+        kept: &mut Vec<bool>,
+    ) {
+        if self.by_diameter.len() != self.chains.len() {
+            self.by_diameter.clear();
+            self.by_diameter
+                .extend(self.chains.iter().enumerate().map(|(index, chain)| {
+                    // Non-negative floats order as their bits; invert for thickest first.
+                    let bits = chain.base_diameter.max(0.0).to_bits();
+                    (u64::from(u32::MAX - bits) << 32) | index as u64
+                }));
+            self.by_diameter.sort_unstable();
+        }
+        kept.clear();
+        kept.resize(self.chains.len(), false);
         let mut used = 0usize;
-        for &index in &self.order_by_diameter {
-            let index = index as usize;
+        for &key in &self.by_diameter {
+            let index = key as u32 as usize;
             let parent = topology.chains[index].parent_chain;
             if parent != NONE && !kept[parent as usize] {
                 continue;
@@ -306,7 +320,6 @@ impl RingFrames {
                 used += triangles;
             }
         }
-        kept
     }
 
     /// Emits the branch mesh with `side_scale` of the finest sides, all chains or the `kept` ones,
@@ -457,7 +470,7 @@ fn push_chain_rings(
     let first = &nodes[chain_nodes[0] as usize];
     let mut previous = Ring {
         center: first.start,
-        tangent: first.heading(),
+        tangent: first.heading,
         reference: Vec3::ZERO,
         binormal: Vec3::ZERO,
         radius: 0.5 * first.diameter,
@@ -477,15 +490,13 @@ fn push_chain_rings(
     let mut arc_length = 0.0;
     for (k, &node_index) in chain_nodes.iter().enumerate() {
         let node = &nodes[node_index as usize];
-        let heading = node.heading();
-        arc_length += node.length();
+        let heading = node.heading;
+        arc_length += node.length;
         let (tangent, radius) = match chain_nodes.get(k + 1) {
             Some(&next) => {
                 let next = &nodes[next as usize];
                 (
-                    (heading + next.heading())
-                        .try_normalize()
-                        .unwrap_or(heading),
+                    (heading + next.heading).try_normalize().unwrap_or(heading),
                     0.5 * next.diameter,
                 )
             }

@@ -89,7 +89,7 @@ impl Default for FruitParams {
 
 /// A leaf to be made: the internode, position along it (0..1) and spiral angle.
 #[derive(Clone, Copy)]
-struct LeafSlot {
+pub(crate) struct LeafSlot {
     /// Where the petiole leaves the branch surface.
     attachment: Vec3,
     /// The branch heading there.
@@ -107,28 +107,26 @@ pub fn build_leaves(
     seed: u64,
     ambient: AmbientFn,
 ) -> TreeMesh {
+    let mut nodes = Vec::new();
+    NodeGeom::collect_into(skeleton, &mut nodes);
     let mut mesh = TreeMesh::default();
-    build_leaves_into(
-        &NodeGeom::collect(skeleton),
-        params,
-        seed,
-        ambient,
-        &mut mesh,
-    );
+    build_leaves_into(&nodes, params, seed, ambient, &mut Vec::new(), &mut mesh);
     mesh
 }
 
-/// [`build_leaves`] into `mesh` (cleared first, capacity reused).
+/// [`build_leaves`] into `mesh` (cleared first, capacity reused), with `slots` as working
+/// memory.
 pub(crate) fn build_leaves_into(
     nodes: &[NodeGeom],
     params: &LeafParams,
     seed: u64,
     ambient: AmbientFn,
+    slots: &mut Vec<LeafSlot>,
     mesh: &mut TreeMesh,
 ) {
     // Slots are made walking the arena in order (its memory and the shadow grid stay in cache)
     // and land at random places by the inside-out Fisher–Yates shuffle.
-    let mut slots: Vec<LeafSlot> = Vec::new();
+    slots.clear();
     let mut rng = Rng::new(seed ^ 0x1eaf);
     // The spiral turns by the golden angle per leaf: a running complex product, renormalised.
     let (golden_sin, golden_cos) = GOLDEN_ANGLE.sin_cos();
@@ -137,13 +135,13 @@ pub(crate) fn build_leaves_into(
         if node.diameter >= params.max_branch_diameter {
             continue;
         }
-        let expected = params.leaves_per_metre * node.length();
+        let expected = params.leaves_per_metre * node.length;
         let jitter = hash_unit(seed ^ ((index as u64) << 20));
         let count = (expected + jitter) as u32;
         if count == 0 {
             continue;
         }
-        let heading = node.heading();
+        let heading = node.heading;
         let left = (node.left - heading * node.left.dot(heading))
             .try_normalize()
             .unwrap_or_else(|| any_perpendicular(heading));
@@ -176,7 +174,7 @@ pub(crate) fn build_leaves_into(
     let target = Vec3::from(params.light_direction)
         .try_normalize()
         .unwrap_or(Vec3::Y);
-    for slot in &slots {
+    for slot in slots.iter() {
         push_leaf(mesh, params, target, slot);
     }
 }

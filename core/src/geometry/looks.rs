@@ -110,6 +110,13 @@ pub fn build_tree_meshes(tree: &Tree) -> super::TreeMeshes {
     build_tree_meshes_with(tree, &mesh_params_for(&tree.species))
 }
 
+/// Meshes of a grown tree with its species' look at level of detail `level` only (see
+/// [`super::build_level`]): what a renderer draws.
+pub fn build_tree_level(tree: &Tree, level: usize) -> super::TreeMeshes {
+    let params = mesh_params_for(&tree.species);
+    super::build_level(&tree.skeleton, &params, &|p| tree.ambient_at(p), level)
+}
+
 /// Meshes of a grown tree with explicit parameters, ambient light from its shadow grid.
 pub fn build_tree_meshes_with(tree: &Tree, params: &MeshParams) -> super::TreeMeshes {
     super::build_meshes(&tree.skeleton, params, &|p| tree.ambient_at(p))

@@ -21,6 +21,7 @@
 mod branches;
 pub mod leaves;
 mod looks;
+mod mesher;
 pub mod synthetic;
 pub mod textures;
 pub mod topology;
@@ -31,7 +32,8 @@ use serde::{Deserialize, Serialize};
 use crate::tree::{NodeId, Skeleton};
 
 pub use leaves::{FruitParams, LeafParams};
-pub use looks::{build_tree_meshes, build_tree_meshes_with, mesh_params_for};
+pub use looks::{build_tree_level, build_tree_meshes, build_tree_meshes_with, mesh_params_for};
+pub use mesher::{Levels, Mesher};
 pub use topology::BranchTopology;
 
 /// Ambient light at a world point: 1 = unshaded sky, 0 = full shade.
@@ -185,6 +187,8 @@ pub struct BranchStart {
 /// One level of detail.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct Lod {
+    /// Index of this level in [`LOD_TRIANGLE_FRACTIONS`] (0 = finest).
+    pub level: usize,
     /// Fraction of the finest level's triangles this level aims at.
     pub target_fraction: f32,
     pub branches: TreeMesh,
@@ -213,7 +217,7 @@ pub struct MaterialColors {
 /// fruit buffer whose prefixes the levels draw.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TreeMeshes {
-    /// Finest first.
+    /// The levels built, finest first: all of them, or the one asked for ([`Levels`]).
     pub lods: Vec<Lod>,
     /// Quads of 4 vertices and 6 indices each, in random order.
     pub leaves: TreeMesh,
@@ -223,7 +227,7 @@ pub struct TreeMeshes {
 }
 
 impl TreeMeshes {
-    /// Triangles drawn at level `lod`; 0 for a level that does not exist.
+    /// Triangles drawn at `lods[lod]`; 0 for a level that was not built.
     pub fn num_triangles(&self, lod: usize) -> usize {
         self.lods.get(lod).map_or(0, Lod::num_triangles)
     }
@@ -250,51 +254,29 @@ pub fn build_meshes(skeleton: &Skeleton, params: &MeshParams, ambient: AmbientFn
     meshes
 }
 
-/// [`build_meshes`] into existing meshes, reusing their buffers: interactive re-meshing after
-/// every edit allocates nothing once the buffers have grown.
+/// [`build_meshes`] into existing meshes, reusing their buffers. Interactive re-meshing that
+/// should allocate nothing keeps a [`Mesher`] (its working memory) between calls.
 pub fn build_meshes_into(
     skeleton: &Skeleton,
     params: &MeshParams,
     ambient: AmbientFn,
     meshes: &mut TreeMeshes,
 ) {
-    let nodes = NodeGeom::collect(skeleton);
-    let topology = BranchTopology::build(skeleton);
-    let rings = branches::RingFrames::build(&nodes, &topology, params, ambient);
-    leaves::build_leaves_into(
-        &nodes,
-        &params.leaves,
-        params.seed,
-        ambient,
-        &mut meshes.leaves,
-    );
-    meshes.fruit.clear();
-    if let Some(fruit) = &params.fruit {
-        leaves::build_fruit_into(skeleton, fruit, ambient, &mut meshes.fruit);
-    }
-    let num_branch_triangles_full = rings.num_triangles(1.0, None);
+    Mesher::new().build_into(skeleton, params, ambient, Levels::All, meshes);
+}
+
+/// The meshes of `skeleton` at level of detail `level` only (0 = finest; clamped to the
+/// coarsest), with the whole leaf and fruit buffers: what a renderer draws, at a fraction of
+/// the cost of every level. `lods` holds that one level, whose [`Lod::level`] says which.
+pub fn build_level(
+    skeleton: &Skeleton,
+    params: &MeshParams,
+    ambient: AmbientFn,
+    level: usize,
+) -> TreeMeshes {
+    let mut meshes = TreeMeshes::default();
+    Mesher::new().build_into(skeleton, params, ambient, Levels::One(level), &mut meshes);
     meshes
-        .lods
-        .resize_with(LOD_TRIANGLE_FRACTIONS.len(), Lod::default);
-    for (lod, &fraction) in meshes.lods.iter_mut().zip(&LOD_TRIANGLE_FRACTIONS) {
-        let (mesh, starts) = (&mut lod.branches, &mut lod.branch_starts);
-        if fraction >= 1.0 {
-            rings.mesh_into(&topology, 1.0, None, mesh, starts);
-        } else {
-            let target = (num_branch_triangles_full as f32 * fraction) as usize;
-            let side_scale = fraction.sqrt();
-            let kept = rings.chains_within_budget(&topology, side_scale, target);
-            rings.mesh_into(&topology, side_scale, Some(&kept), mesh, starts);
-        }
-        lod.target_fraction = fraction;
-        lod.num_leaf_indices = prefix_indices(meshes.leaves.indices.len(), 6, fraction);
-        lod.num_fruit_indices = prefix_indices(meshes.fruit.indices.len(), 3, fraction);
-    }
-    meshes.colors = MaterialColors {
-        bark: params.bark_color,
-        leaf: params.leaf_color,
-        fruit: params.fruit_color,
-    };
 }
 
 /// The number of indices of a `fraction` prefix, rounded to whole primitives of `unit` indices.
@@ -312,28 +294,28 @@ pub(crate) struct NodeGeom {
     pub end: Vec3,
     pub left: Vec3,
     pub diameter: f32,
+    /// Unit heading H (start → end); +Y for a degenerate internode.
+    pub heading: Vec3,
+    pub length: f32,
 }
 
 impl NodeGeom {
-    pub(crate) fn collect(skeleton: &Skeleton) -> Vec<NodeGeom> {
-        skeleton
-            .internodes
-            .iter()
-            .map(|n| NodeGeom {
-                start: n.start,
-                end: n.end,
-                left: n.left,
-                diameter: n.diameter,
-            })
-            .collect()
+    pub(crate) fn new(node: &crate::tree::Internode) -> Self {
+        let axis = node.end - node.start;
+        NodeGeom {
+            start: node.start,
+            end: node.end,
+            left: node.left,
+            diameter: node.diameter,
+            heading: axis.try_normalize().unwrap_or(Vec3::Y),
+            length: axis.length(),
+        }
     }
 
-    pub(crate) fn heading(&self) -> Vec3 {
-        (self.end - self.start).try_normalize().unwrap_or(Vec3::Y)
-    }
-
-    pub(crate) fn length(&self) -> f32 {
-        (self.end - self.start).length()
+    /// The geometry of every internode of `skeleton`, into `nodes` (cleared first).
+    pub(crate) fn collect_into(skeleton: &Skeleton, nodes: &mut Vec<NodeGeom>) {
+        nodes.clear();
+        nodes.extend(skeleton.internodes.iter().map(NodeGeom::new));
     }
 }
 

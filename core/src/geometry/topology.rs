@@ -37,25 +37,33 @@ impl BranchTopology {
     /// Reorganises `skeleton` along thickest paths. The continuation of an internode is its
     /// thickest child, the apex's own continuation winning ties.
     pub fn build(skeleton: &Skeleton) -> Self {
+        let mut topology = BranchTopology::default();
+        topology.build_into(skeleton);
+        topology
+    }
+
+    /// [`BranchTopology::build`] into `self`, reusing its buffers.
+    pub fn build_into(&mut self, skeleton: &Skeleton) {
         let nodes = &skeleton.internodes;
-        let visual_child: Vec<u32> = nodes
-            .iter()
-            .map(|node| {
-                let mut best = NONE;
-                let mut best_diameter = f32::NEG_INFINITY;
-                for child in node.children() {
-                    let diameter = nodes[child.index()].diameter;
-                    if diameter > best_diameter {
-                        best = child.0;
-                        best_diameter = diameter;
-                    }
+        self.visual_child.clear();
+        self.visual_child.extend(nodes.iter().map(|node| {
+            let mut best = NONE;
+            let mut best_diameter = f32::NEG_INFINITY;
+            for child in node.children() {
+                let diameter = nodes[child.index()].diameter;
+                if diameter > best_diameter {
+                    best = child.0;
+                    best_diameter = diameter;
                 }
-                best
-            })
-            .collect();
-        let mut chain_of_node = vec![NONE; nodes.len()];
-        let mut chain_nodes = Vec::with_capacity(nodes.len());
-        let mut chains = Vec::new();
+            }
+            best
+        }));
+        let visual_child = &self.visual_child;
+        self.chain_of_node.clear();
+        self.chain_of_node.resize(nodes.len(), NONE);
+        self.chain_nodes.clear();
+        self.chain_nodes.reserve(nodes.len());
+        self.chains.clear();
         for (index, node) in nodes.iter().enumerate() {
             let parent_node = node.parent.map_or(NONE, |p| p.0);
             let starts_chain =
@@ -63,32 +71,26 @@ impl BranchTopology {
             if !starts_chain {
                 continue;
             }
-            let chain_index = chains.len() as u32;
-            let first = chain_nodes.len() as u32;
+            let chain_index = self.chains.len() as u32;
+            let first = self.chain_nodes.len() as u32;
             let mut current = index as u32;
             while current != NONE {
-                chain_nodes.push(current);
-                chain_of_node[current as usize] = chain_index;
+                self.chain_nodes.push(current);
+                self.chain_of_node[current as usize] = chain_index;
                 current = visual_child[current as usize];
             }
             let parent_chain = if parent_node == NONE {
                 NONE
             } else {
                 // The parent is earlier in topological order, so its chain already exists.
-                chain_of_node[parent_node as usize]
+                self.chain_of_node[parent_node as usize]
             };
-            chains.push(Chain {
+            self.chains.push(Chain {
                 first,
-                len: chain_nodes.len() as u32 - first,
+                len: self.chain_nodes.len() as u32 - first,
                 parent_node,
                 parent_chain,
             });
-        }
-        BranchTopology {
-            chains,
-            chain_nodes,
-            visual_child,
-            chain_of_node,
         }
     }
 
