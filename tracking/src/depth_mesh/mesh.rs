@@ -1,39 +1,17 @@
 //! The incremental two-layer triangulation: insert, remove, move, per-frame update.
-
-use std::collections::{HashMap, HashSet};
-use std::hash::{BuildHasherDefault, Hasher};
+//!
+//! An update touches the triangulations only where points changed: lost points are removed,
+//! new ones inserted from a nearby hint, moved ones moved in place when their star allows it
+//! (else removed and re-inserted next to a former neighbour). Consistency is re-evaluated for
+//! the changed points and their neighbours only, and the surface follows those verdicts. The
+//! scratch buffers live in the mesh, so a steady-state update does not allocate.
 
 use glam::Vec2;
-use spade::handles::FixedVertexHandle;
-use spade::{DelaunayTriangulation, HasPosition, HierarchyHintGenerator, Point2, Triangulation};
+use spade::{HasPosition, Point2, Triangulation};
 
+use super::consistency::Scratch;
+use super::layer::{IdMap, IdSet, Layer};
 use super::{DepthMeshConfig, DepthMeshError, Observation, PinholeIntrinsics};
-
-/// Map-point ids are already well spread integers: a multiplicative hash (Fibonacci hashing)
-/// is enough and several times faster than SipHash on this hot path.
-#[derive(Default)]
-pub(crate) struct IdHasher(u64);
-
-impl Hasher for IdHasher {
-    fn finish(&self) -> u64 {
-        self.0
-    }
-
-    fn write(&mut self, bytes: &[u8]) {
-        for &byte in bytes {
-            self.0 = (self.0.rotate_left(8) ^ byte as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15);
-        }
-    }
-
-    fn write_u64(&mut self, value: u64) {
-        self.0 = (self.0 ^ value)
-            .wrapping_mul(0x9e37_79b9_7f4a_7c15)
-            .rotate_left(29);
-    }
-}
-
-pub(crate) type IdMap<V> = HashMap<u64, V, BuildHasherDefault<IdHasher>>;
-pub(crate) type IdSet = HashSet<u64, BuildHasherDefault<IdHasher>>;
 
 /// A vertex: pixel position, depth and the map point it came from.
 #[derive(Clone, Copy, Debug, Default, PartialEq)]
@@ -51,85 +29,6 @@ impl HasPosition for MeshVertex {
     }
 }
 
-/// The hierarchy hint generator makes point location O(log n) for queries anywhere.
-pub(crate) type Triangles =
-    DelaunayTriangulation<MeshVertex, (), (), (), HierarchyHintGenerator<f64>>;
-
-/// One triangulation with its id → handle map (spade moves the last vertex into a removed
-/// vertex's slot, so handles are fixed up on every removal).
-#[derive(Default)]
-pub(crate) struct Layer {
-    pub(crate) triangles: Triangles,
-    pub(crate) handles: IdMap<FixedVertexHandle>,
-}
-
-impl Layer {
-    /// Inserts a vertex. Spade would silently overwrite a vertex at the same position, so the
-    /// caller checks for duplicates (`check_duplicate`) unless it already did, or the layer is
-    /// the surface (a subset of the positions of all points, which are unique).
-    fn insert(&mut self, vertex: MeshVertex, check_duplicate: bool) -> Result<(), DepthMeshError> {
-        if let Some(existing) = check_duplicate
-            .then(|| self.triangles.locate_vertex(vertex.position()))
-            .flatten()
-        {
-            let other = existing.data().id;
-            return Err(DepthMeshError::DuplicatePosition {
-                id: vertex.id,
-                other,
-                u: vertex.pixel.x,
-                v: vertex.pixel.y,
-            });
-        }
-        let handle = self
-            .triangles
-            .insert(vertex)
-            .map_err(|e| DepthMeshError::Triangulation {
-                id: vertex.id,
-                reason: format!("{e:?}"),
-            })?;
-        self.handles.insert(vertex.id, handle);
-        Ok(())
-    }
-
-    fn remove(&mut self, id: u64) -> Option<MeshVertex> {
-        let handle = self.handles.remove(&id)?;
-        let removed = self.triangles.remove(handle);
-        if handle.index() < self.triangles.num_vertices() {
-            let moved_id = self.triangles.vertex(handle).data().id;
-            self.handles.insert(moved_id, handle);
-        }
-        Some(removed)
-    }
-
-    pub(crate) fn get(&self, id: u64) -> Option<MeshVertex> {
-        self.handles
-            .get(&id)
-            .map(|&h| *self.triangles.vertex(h).data())
-    }
-
-    fn neighbours(&self, id: u64) -> Vec<MeshVertex> {
-        let Some(&handle) = self.handles.get(&id) else {
-            return Vec::new();
-        };
-        self.triangles
-            .vertex(handle)
-            .out_edges()
-            .map(|edge| *edge.to().data())
-            .collect()
-    }
-
-    fn neighbour_ids(&self, id: u64) -> Vec<u64> {
-        let Some(&handle) = self.handles.get(&id) else {
-            return Vec::new();
-        };
-        self.triangles
-            .vertex(handle)
-            .out_edges()
-            .map(|edge| edge.to().data().id)
-            .collect()
-    }
-}
-
 /// What one [`DepthMesh::update`] did.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct UpdateStats {
@@ -142,12 +41,50 @@ pub struct UpdateStats {
     pub num_inconsistent: usize,
 }
 
+/// Scratch state of one edit, kept between updates so that they do not allocate.
+#[derive(Default)]
+pub(crate) struct Work {
+    /// Ids observed in the current frame.
+    seen: IdSet,
+    lost: Vec<u64>,
+    /// Points inserted, moved or given a new depth: they have no standing in the surface yet.
+    pub(crate) changed: Vec<u64>,
+    /// Vertices whose consistency must be re-evaluated (`dirty_set` deduplicates).
+    pub(crate) dirty: Vec<u64>,
+    dirty_set: IdSet,
+    /// Lenient verdicts (any neighbours vouch) of the changed points.
+    pub(crate) lenient: IdMap<bool>,
+    pub(crate) verdicts: Vec<(MeshVertex, bool)>,
+    pub(crate) scratch: Scratch,
+    reinsert: Vec<MeshVertex>,
+}
+
+impl Work {
+    fn clear(&mut self) {
+        self.seen.clear();
+        self.lost.clear();
+        self.changed.clear();
+        self.dirty.clear();
+        self.dirty_set.clear();
+        self.lenient.clear();
+        self.verdicts.clear();
+        self.reinsert.clear();
+    }
+
+    fn mark_dirty(&mut self, id: u64) {
+        if self.dirty_set.insert(id) {
+            self.dirty.push(id);
+        }
+    }
+}
+
 /// The scene depth mesh of one camera (see the module docs).
 pub struct DepthMesh {
     pub(crate) camera: PinholeIntrinsics,
     pub(crate) config: DepthMeshConfig,
     pub(crate) all: Layer,
     pub(crate) surface: Layer,
+    work: Work,
 }
 
 impl DepthMesh {
@@ -155,8 +92,9 @@ impl DepthMesh {
         Self {
             camera,
             config,
-            all: Layer::default(),
-            surface: Layer::default(),
+            all: Layer::new(&camera),
+            surface: Layer::new(&camera),
+            work: Work::default(),
         }
     }
 
@@ -210,13 +148,13 @@ impl DepthMesh {
 
     /// Inserts a point, or moves it if its id is already held.
     pub fn insert(&mut self, observation: Observation) -> Result<(), DepthMeshError> {
-        let mut dirty = IdSet::default();
-        let result = self.insert_or_move(observation, &mut dirty);
-        self.refresh(dirty);
+        let mut work = self.begin();
+        let result = self.insert_or_move(observation, &mut work);
+        self.finish(work);
         result.map(|_| ())
     }
 
-    /// Moves a held point (remove + insert: spade has no move).
+    /// Moves a held point.
     pub fn move_point(&mut self, observation: Observation) -> Result<(), DepthMeshError> {
         if !self.all.handles.contains_key(&observation.id) {
             return Err(DepthMeshError::UnknownPoint { id: observation.id });
@@ -226,249 +164,181 @@ impl DepthMesh {
 
     /// Removes a point; unknown ids are an error value.
     pub fn remove(&mut self, id: u64) -> Result<(), DepthMeshError> {
-        let mut dirty = IdSet::default();
-        if !self.remove_into(id, &mut dirty) {
-            return Err(DepthMeshError::UnknownPoint { id });
+        let mut work = self.begin();
+        let removed = self.remove_into(id, &mut work);
+        self.finish(work);
+        if removed {
+            Ok(())
+        } else {
+            Err(DepthMeshError::UnknownPoint { id })
         }
-        self.refresh(dirty);
-        Ok(())
     }
 
     /// Brings the mesh to the current frame: points absent from `observations` are removed,
     /// new ones inserted, moved ones moved. Invalid observations are counted and skipped.
     pub fn update(&mut self, observations: &[Observation]) -> UpdateStats {
         let mut stats = UpdateStats::default();
-        let mut dirty = IdSet::default();
-        let seen: IdSet = observations.iter().map(|o| o.id).collect();
-        let lost: Vec<u64> = self
-            .all
-            .handles
-            .keys()
-            .copied()
-            .filter(|id| !seen.contains(id))
-            .collect();
-        for id in lost {
-            self.remove_into(id, &mut dirty);
-            stats.num_removed += 1;
+        let mut work = self.begin();
+        work.seen.extend(observations.iter().map(|o| o.id));
+        let seen = &work.seen;
+        work.lost
+            .extend(self.all.handles.keys().filter(|id| !seen.contains(id)));
+        let lost = std::mem::take(&mut work.lost);
+        for &id in &lost {
+            self.remove_into(id, &mut work);
         }
+        stats.num_removed = lost.len();
+        work.lost = lost;
         for observation in observations {
-            match self.insert_or_move(*observation, &mut dirty) {
+            match self.insert_or_move(*observation, &mut work) {
                 Ok(Change::Inserted) => stats.num_inserted += 1,
                 Ok(Change::Moved) => stats.num_moved += 1,
                 Ok(Change::None) => {}
                 Err(_) => stats.num_rejected += 1,
             }
         }
-        self.refresh(dirty);
+        self.finish(work);
         stats.num_inconsistent = self.num_points() - self.num_surface_points();
         stats
     }
 
-    fn remove_into(&mut self, id: u64, dirty: &mut IdSet) -> bool {
-        let neighbours = self.all.neighbour_ids(id);
-        if self.all.remove(id).is_none() {
+    /// Takes the scratch buffers out of the mesh, cleared.
+    fn begin(&mut self) -> Work {
+        let mut work = std::mem::take(&mut self.work);
+        work.clear();
+        work
+    }
+
+    /// Re-evaluates the touched vertices, mirrors them into the surface and puts the scratch
+    /// buffers back.
+    fn finish(&mut self, mut work: Work) {
+        self.refresh(&mut work);
+        self.work = work;
+    }
+
+    /// Marks `id` and its current neighbours for re-evaluation.
+    fn mark_with_neighbours(&self, id: u64, work: &mut Work) {
+        work.mark_dirty(id);
+        for n in self.all.neighbours(id) {
+            work.mark_dirty(n.id);
+        }
+    }
+
+    fn remove_into(&mut self, id: u64, work: &mut Work) -> bool {
+        if !self.all.handles.contains_key(&id) {
             return false;
         }
+        for n in self.all.neighbours(id) {
+            work.mark_dirty(n.id);
+        }
+        self.all.remove(id);
         self.surface.remove(id);
-        dirty.extend(neighbours);
-        dirty.remove(&id);
         true
     }
 
     fn insert_or_move(
         &mut self,
         observation: Observation,
-        dirty: &mut IdSet,
+        work: &mut Work,
     ) -> Result<Change, DepthMeshError> {
         let vertex = self.validate(&observation)?;
-        let change = match self.all.get(vertex.id) {
-            None => Change::Inserted,
-            Some(old) => {
-                let moved = old.pixel.distance(vertex.pixel) > self.config.move_tolerance_px;
-                let relative = (old.depth_m - vertex.depth_m).abs() / old.depth_m;
-                if !moved && relative <= 1e-3 {
-                    return Ok(Change::None);
-                }
-                if !moved {
-                    // Same place, new depth: update the data in both layers, no re-triangulation.
-                    for layer in [&mut self.all, &mut self.surface] {
-                        if let Some(&h) = layer.handles.get(&vertex.id) {
-                            layer.triangles.vertex_data_mut(h).depth_m = vertex.depth_m;
-                        }
-                    }
-                    dirty.insert(vertex.id);
-                    dirty.extend(self.all.neighbour_ids(vertex.id));
-                    return Ok(Change::Moved);
-                }
-                Change::Moved
-            }
+        let Some(old) = self.all.get(vertex.id) else {
+            self.all.insert(vertex, None)?;
+            work.changed.push(vertex.id);
+            self.mark_with_neighbours(vertex.id, work);
+            return Ok(Change::Inserted);
         };
-        if let Some(existing) = self.all.triangles.locate_vertex(vertex.position()) {
-            let other = existing.data().id;
-            if other != vertex.id {
-                return Err(DepthMeshError::DuplicatePosition {
-                    id: vertex.id,
-                    other,
-                    u: vertex.pixel.x,
-                    v: vertex.pixel.y,
-                });
+        let moved = old.pixel.distance(vertex.pixel) > self.config.move_tolerance_px;
+        let relative = (old.depth_m - vertex.depth_m).abs() / old.depth_m;
+        if !moved && relative <= 1e-3 {
+            return Ok(Change::None);
+        }
+        if moved {
+            // Neighbours before the move lose or change a neighbour too.
+            for n in self.all.neighbours(vertex.id) {
+                work.mark_dirty(n.id);
             }
+            self.all.move_vertex(vertex)?;
+        } else {
+            // Same place, new depth: no re-triangulation in either layer.
+            self.all.set_depth(vertex.id, vertex.depth_m);
+            self.surface.set_depth(vertex.id, vertex.depth_m);
         }
-        if change == Change::Moved {
-            self.remove_into(vertex.id, dirty);
-        }
-        self.all.insert(vertex, false)?;
-        dirty.insert(vertex.id);
-        dirty.extend(self.all.neighbour_ids(vertex.id));
-        Ok(change)
+        work.changed.push(vertex.id);
+        self.mark_with_neighbours(vertex.id, work);
+        Ok(Change::Moved)
     }
 
-    /// Re-evaluates the consistency of `dirty` vertices and mirrors them into the surface.
+    /// Re-evaluates the consistency of the dirty vertices and mirrors them into the surface.
     ///
-    /// Support only counts from trusted neighbours, so outliers cannot vouch for each other:
-    /// for a bulk change a lenient first pass (any neighbours) decides whom to trust; otherwise
-    /// the trusted are the vertices already in the surface.
-    fn refresh(&mut self, dirty: IdSet) {
-        let vertices: Vec<MeshVertex> = dirty.iter().filter_map(|&id| self.all.get(id)).collect();
-        // The lenient first pass only matters while there is no established surface to trust
-        // (a first frame, a relocalisation); in steady state a frame changes few points and
-        // the surface's own membership is the trust.
-        let bulk = vertices.len() * 4 > self.all.handles.len();
-        let first: IdMap<bool> = if bulk {
-            vertices
-                .iter()
-                .map(|v| (v.id, self.is_supported(v, &|_| true, false)))
-                .collect()
-        } else {
-            IdMap::default()
-        };
+    /// Support only counts from trusted neighbours, so outliers cannot vouch for each other.
+    /// A vertex untouched by this edit is trusted when it is in the surface; a changed one
+    /// (new, moved, new depth) has no standing yet, so a lenient first verdict (any neighbours
+    /// vouch, 1-ring only) decides whether it is trusted. On a first frame every vertex is new
+    /// and this is a lenient pass followed by a strict one over all points.
+    fn refresh(&mut self, work: &mut Work) {
+        let Work {
+            changed,
+            dirty,
+            lenient,
+            verdicts,
+            scratch,
+            ..
+        } = work;
+        for &id in changed.iter() {
+            if let Some(&handle) = self.all.handles.get(&id) {
+                lenient.insert(id, self.is_supported(handle, &|_| true, false, scratch));
+            }
+        }
+        let surface = &self.surface;
         let trusted = |id: u64| {
-            first
+            lenient
                 .get(&id)
                 .copied()
-                .unwrap_or_else(|| self.surface.handles.contains_key(&id))
+                .unwrap_or_else(|| surface.handles.contains_key(&id))
         };
-        let second: Vec<(MeshVertex, bool)> = vertices
-            .iter()
-            .map(|v| (*v, self.is_supported(v, &trusted, true)))
-            .collect();
-        for (vertex, consistent) in second {
-            let id = vertex.id;
-            match (consistent, self.surface.get(id)) {
-                (true, None) => {
-                    let _ = self.surface.insert(vertex, false);
-                }
-                (true, Some(old)) if old.pixel != vertex.pixel => {
-                    self.surface.remove(id);
-                    let _ = self.surface.insert(vertex, false);
-                }
-                (true, Some(_)) => {}
-                (false, Some(_)) => {
-                    self.surface.remove(id);
-                }
-                (false, None) => {}
+        for &id in dirty.iter() {
+            if let Some(&handle) = self.all.handles.get(&id) {
+                let consistent = self.is_supported(handle, &trusted, true, scratch);
+                verdicts.push((*self.all.triangles.vertex(handle).data(), consistent));
             }
         }
+        self.apply_verdicts(work);
     }
 
-    /// Whether some triangle of trusted neighbours predicts the vertex's inverse depth
-    /// (inverse depth is affine in the image over a plane, so planar surfaces predict
-    /// exactly). Tries the 1-ring first, then (if asked) adds the 2-ring.
-    fn is_supported(
-        &self,
-        vertex: &MeshVertex,
-        trusted: &dyn Fn(u64) -> bool,
-        use_second_ring: bool,
-    ) -> bool {
-        if self.all.handles.len() < 5 {
-            return true;
-        }
-        let ring = self.all.neighbours(vertex.id);
-        let mut candidates: Vec<MeshVertex> = ring
-            .iter()
-            .filter(|v| trusted(v.id))
-            .take(10)
-            .copied()
-            .collect();
-        if ring.len() < 3 {
-            return true;
-        }
-        if self.any_triple_predicts(vertex, &candidates, 0) {
-            return true;
-        }
-        if !use_second_ring {
-            return false;
-        }
-        let num_first = candidates.len();
-        for first in &ring {
-            for second in self.all.neighbours(first.id) {
-                if candidates.len() >= 16 {
-                    break;
+    /// Brings the surface in line with the verdicts: first every removal and move (so no
+    /// stale position remains), then the insertions.
+    fn apply_verdicts(&mut self, work: &mut Work) {
+        for &(vertex, consistent) in &work.verdicts {
+            let Some(old) = self.surface.get(vertex.id) else {
+                if consistent {
+                    work.reinsert.push(vertex);
                 }
-                if second.id != vertex.id
-                    && !ring.iter().any(|r| r.id == second.id)
-                    && trusted(second.id)
-                    && !candidates.iter().any(|c| c.id == second.id)
-                {
-                    candidates.push(second);
+                continue;
+            };
+            if !consistent {
+                self.surface.remove(vertex.id);
+            } else if old.pixel != vertex.pixel {
+                if self.surface.move_vertex(vertex).is_err() {
+                    // Its new position still holds a surface vertex that moves away later in
+                    // this loop: insert it after all moves.
+                    self.surface.remove(vertex.id);
+                    work.reinsert.push(vertex);
                 }
+            } else if old.depth_m != vertex.depth_m {
+                self.surface.set_depth(vertex.id, vertex.depth_m);
             }
         }
-        candidates.len() > num_first && self.any_triple_predicts(vertex, &candidates, num_first)
-    }
-
-    fn bridges_discontinuity(&self, triple: &[MeshVertex; 3]) -> bool {
-        let c = &self.config;
-        super::query::classify_triangle(
-            triple,
-            &self.camera,
-            f32::INFINITY,
-            c.min_plane_distance_m,
-            c.min_discontinuity_ratio,
-        )
-        .is_err()
-    }
-
-    /// Tries triples of `candidates` holding at least one index `>= first_new`.
-    fn any_triple_predicts(
-        &self,
-        vertex: &MeshVertex,
-        candidates: &[MeshVertex],
-        first_new: usize,
-    ) -> bool {
-        let w = 1.0 / vertex.depth_m;
-        let tolerance = self.config.consistency_tolerance * w;
-        let predicts = |i: usize, j: usize, k: usize| {
-            let triple = [candidates[i], candidates[j], candidates[k]];
-            // A triple bridging a discontinuity predicts every depth in between.
-            !self.bridges_discontinuity(&triple)
-                && predict_inverse_depth(vertex.pixel, triple[0], triple[1], triple[2])
-                    .is_some_and(|predicted| (predicted - w).abs() <= tolerance)
-        };
-        let n = candidates.len();
-        // Ring neighbours come in angular order: triples a third of the ring apart surround
-        // the vertex (interpolation, not extrapolation) and usually settle it at once.
-        if first_new == 0 && n >= 3 {
-            let third = n / 3;
-            if (0..third.max(1)).any(|i| predicts(i, i + third, (i + 2 * third).min(n - 1))) {
-                return true;
-            }
+        for &vertex in &work.reinsert {
+            // Every surface vertex is now at its current position, unique among all points.
+            let _ = self.surface.insert(vertex, None);
         }
-        for i in 0..n {
-            for j in i + 1..n {
-                for k in j.max(first_new.saturating_sub(1)) + 1..n {
-                    if predicts(i, j, k) {
-                        return true;
-                    }
-                }
-            }
-        }
-        false
     }
 
     /// Checks the invariants (spade keeps its own checks test-only, so these are ours): every
-    /// id maps to the vertex holding it, the surface is a subset of all points, and both
-    /// layers are Delaunay triangulations (see [`super::validity::check_triangulation`]).
+    /// id maps to the vertex holding it, the surface is a subset of all points at the same
+    /// positions, and both layers are Delaunay triangulations (see
+    /// [`super::validity::check_triangulation`]).
     pub fn sanity_check(&self) {
         for layer in [&self.all, &self.surface] {
             assert_eq!(
@@ -486,10 +356,9 @@ impl DepthMesh {
             super::validity::check_triangulation(&layer.triangles);
         }
         for &id in self.surface.handles.keys() {
-            assert!(
-                self.all.handles.contains_key(&id),
-                "surface point {id} not in all points"
-            );
+            let (surface, all) = (self.surface.get(id), self.all.get(id));
+            assert!(all.is_some(), "surface point {id} not in all points");
+            assert_eq!(surface, all, "surface point {id} differs from all points");
         }
     }
 }
@@ -499,21 +368,4 @@ enum Change {
     Inserted,
     Moved,
     None,
-}
-
-/// Inverse depth at `pixel` of the plane through three vertices (in (u, v, 1/z)), if the
-/// triangle is not degenerate and `pixel` is not far outside it.
-fn predict_inverse_depth(pixel: Vec2, a: MeshVertex, b: MeshVertex, c: MeshVertex) -> Option<f32> {
-    let (ab, ac, ap) = (b.pixel - a.pixel, c.pixel - a.pixel, pixel - a.pixel);
-    let area2 = ab.perp_dot(ac);
-    if area2.abs() < 4.0 {
-        return None;
-    }
-    let beta = ap.perp_dot(ac) / area2;
-    let gamma = ab.perp_dot(ap) / area2;
-    let alpha = 1.0 - beta - gamma;
-    if alpha.min(beta).min(gamma) < -0.5 {
-        return None;
-    }
-    Some(alpha / a.depth_m + beta / b.depth_m + gamma / c.depth_m)
 }

@@ -23,7 +23,9 @@
 //! Camera space: OpenCV (X right, Y down, Z forward), metres;
 //! depth is camera Z. `world_from_camera` maps camera space into the world (metres, Y up).
 
+mod consistency;
 mod export;
+mod layer;
 mod mesh;
 mod query;
 mod validity;

@@ -2,10 +2,21 @@
 
 use glam::{Affine3A, Vec2, Vec3};
 use spade::handles::{FixedFaceHandle, InnerTag};
-use spade::{Point2, PositionInTriangulation, Triangulation};
+use spade::{PositionInTriangulation, Triangulation};
 
 use super::mesh::MeshVertex;
 use super::{DepthMesh, PinholeIntrinsics};
+
+/// Most faces a query walk crosses before handing over to spade's point location (a walk
+/// from the hint grid usually crosses a few).
+const MAX_WALK_STEPS: usize = 256;
+
+/// Outcome of a query walk.
+enum Walk {
+    Found(FixedFaceHandle<InnerTag>),
+    OutsideHull,
+    GaveUp,
+}
 
 /// Why the mesh has no depth at a pixel.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -79,10 +90,57 @@ impl DepthMesh {
             .map(|v| *v.data())
     }
 
-    /// A triangle containing `point`, if any.
-    fn containing_face(&self, point: Point2<f64>) -> Option<FixedFaceHandle<InnerTag>> {
+    /// A triangle containing `pixel`, if any: a walk from a face next to the hint grid's
+    /// vertex, or spade's exact point location where the walk gives up.
+    fn containing_face(&self, pixel: Vec2) -> Option<FixedFaceHandle<InnerTag>> {
+        match self.walk_to_face(pixel) {
+            Walk::Found(face) => Some(face),
+            Walk::OutsideHull => None,
+            Walk::GaveUp => self.locate_face(pixel),
+        }
+    }
+
+    /// Visibility walk: from a face near `pixel`, cross an edge that has `pixel` strictly on
+    /// its outer side until no edge does. On a Delaunay triangulation it ends; leaving the
+    /// convex hull means no triangle holds the pixel. Floating-point orientation suffices
+    /// here: a pixel within round-off of an edge belongs to either face, and a walk that
+    /// round-off sends in circles gives up after a bounded number of steps.
+    fn walk_to_face(&self, pixel: Vec2) -> Walk {
         let triangles = &self.surface.triangles;
-        match triangles.locate(point) {
+        if triangles.num_inner_faces() == 0 {
+            return Walk::OutsideHull;
+        }
+        let Some(start) = self.surface.hint(pixel) else {
+            return Walk::GaveUp;
+        };
+        let Some(mut face) = triangles
+            .vertex(start)
+            .out_edges()
+            .find_map(|edge| edge.face().as_inner())
+        else {
+            return Walk::GaveUp;
+        };
+        let (px, py) = (pixel.x as f64, pixel.y as f64);
+        for _ in 0..MAX_WALK_STEPS {
+            let exit = face.adjacent_edges().into_iter().find(|edge| {
+                let [a, b] = edge.positions();
+                (b.x - a.x) * (py - a.y) - (b.y - a.y) * (px - a.x) < 0.0
+            });
+            let Some(exit) = exit else {
+                return Walk::Found(face.fix());
+            };
+            match exit.rev().face().as_inner() {
+                Some(next) => face = next,
+                None => return Walk::OutsideHull,
+            }
+        }
+        Walk::GaveUp
+    }
+
+    /// Spade's exact point location (the fallback of [`Self::walk_to_face`]).
+    fn locate_face(&self, pixel: Vec2) -> Option<FixedFaceHandle<InnerTag>> {
+        let triangles = &self.surface.triangles;
+        match self.surface.locate(pixel, None) {
             PositionInTriangulation::OnFace(face) => Some(face),
             PositionInTriangulation::OnEdge(edge) => {
                 let edge = triangles.directed_edge(edge);
@@ -107,8 +165,7 @@ impl DepthMesh {
         if !(pixel.is_finite() && self.camera.contains(pixel)) {
             return DepthSample::Unknown(UnknownReason::OutsideImage);
         }
-        let point = Point2::new(pixel.x as f64, pixel.y as f64);
-        let Some(face) = self.containing_face(point) else {
+        let Some(face) = self.containing_face(pixel) else {
             return DepthSample::Unknown(UnknownReason::NoTriangle);
         };
         let vertices = self.face_vertices(face);

@@ -2,7 +2,7 @@
 
 use spade::Triangulation;
 
-use super::mesh::Triangles;
+use super::layer::Triangles;
 
 /// Panics with a message if `triangles` is not a valid Delaunay triangulation: every inner
 /// face counter-clockwise and non-degenerate, edges consistent with their twins, Euler's
