@@ -3,7 +3,7 @@
 //! growth shadow grid), converted to the renderer's vertices.
 
 use glam::Vec3;
-use sylva_core::geometry::{TreeMeshes, build_tree_meshes};
+use sylva_core::geometry::{TreeMeshes, build_tree_level};
 use sylva_core::{Skeleton, Tree};
 
 use crate::render::{LitMesh, LitVertex, TreeMesh};
@@ -56,9 +56,10 @@ pub fn trunk_point(skeleton: &Skeleton, h: f32) -> Vec3 {
     }
 }
 
-/// The mesh drawn for a tree: bark and alpha-cut leaves of the finest level of detail.
+/// The mesh drawn for a tree: bark and alpha-cut leaves of the finest level of detail (only
+/// that level is built).
 pub fn mesh_of(tree: &Tree) -> TreeMesh {
-    draw_mesh(&build_tree_meshes(tree))
+    draw_mesh(&build_tree_level(tree, 0))
 }
 
 /// The renderer's mesh of `sylva_core` meshes (level 0). Leaf texture coordinates go from

@@ -110,22 +110,31 @@ pub fn build_leaves(
     let mut nodes = Vec::new();
     NodeGeom::collect_into(skeleton, &mut nodes);
     let mut mesh = TreeMesh::default();
-    build_leaves_into(&nodes, params, seed, ambient, &mut Vec::new(), &mut mesh);
+    let mut scratch = LeafScratch::default();
+    build_leaves_into(&nodes, params, seed, ambient, &mut scratch, &mut mesh);
     mesh
 }
 
-/// [`build_leaves`] into `mesh` (cleared first, capacity reused), with `slots` as working
+/// Working memory of [`build_leaves_into`]: the leaf slots.
+#[derive(Default)]
+pub(crate) struct LeafScratch {
+    slots: Vec<LeafSlot>,
+}
+
+/// [`build_leaves`] into `mesh` (cleared first, capacity reused), with `scratch` as working
 /// memory.
 pub(crate) fn build_leaves_into(
     nodes: &[NodeGeom],
     params: &LeafParams,
     seed: u64,
     ambient: AmbientFn,
-    slots: &mut Vec<LeafSlot>,
+    scratch: &mut LeafScratch,
     mesh: &mut TreeMesh,
 ) {
-    // Slots are made walking the arena in order (its memory and the shadow grid stay in cache)
-    // and land at random places by the inside-out Fisher–Yates shuffle.
+    let slots = &mut scratch.slots;
+    // Slots are made walking the arena in order (its memory and the shadow grid stay in cache),
+    // then shuffled in a pass of their own by the inside-out Fisher–Yates shuffle (a tight
+    // loop keeps many of its cache misses in flight), then made into leaves in that order.
     slots.clear();
     let mut rng = Rng::new(seed ^ 0x1eaf);
     // The spiral turns by the golden angle per leaf: a running complex product, renormalised.
@@ -163,63 +172,122 @@ pub(crate) fn build_leaves_into(
                 radial,
                 light: ambient(attachment).clamp(0.0, 1.0),
             };
-            let i = slots.len();
-            let j = rng.below(i as u32 + 1) as usize;
             slots.push(slot);
-            slots.swap(i, j);
         }
+    }
+    for i in 0..slots.len() {
+        let j = rng.below(i as u32 + 1) as usize;
+        slots.swap(i, j);
     }
     mesh.clear();
     mesh.reserve(slots.len() * 4, slots.len() * 6);
-    let target = Vec3::from(params.light_direction)
-        .try_normalize()
-        .unwrap_or(Vec3::Y);
+    let petiole = Petiole::new(params);
     for slot in slots.iter() {
-        push_leaf(mesh, params, target, slot);
+        push_leaf(mesh, &petiole, slot);
     }
 }
 
-fn push_leaf(mesh: &mut TreeMesh, params: &LeafParams, target: Vec3, slot: &LeafSlot) {
-    let LeafSlot {
-        attachment,
-        heading,
-        radial,
-        light,
-    } = *slot;
-    let (sin_i, cos_i) = params.insertion_angle.sin_cos();
-    let mut h = heading * cos_i + radial * sin_i;
-    let mut l = heading
-        .cross(radial)
-        .try_normalize()
-        .unwrap_or_else(|| any_perpendicular(h));
-    let steps = params.petiole_steps.max(1);
-    let ds = params.petiole_length / steps as f32;
-    let mut position = attachment;
-    for _ in 0..steps {
-        let u = h.cross(l);
-        let omega_h = -params.twist_rate * l.dot(target);
-        let omega_l = params.bend_rate * h.dot(target);
-        let omega_u = params.turn_rate * l.dot(target.cross(h.cross(target)));
-        // Rotation by the vector Ω·Δs, through the quaternion (Ω·Δs/2, 1) normalised: no
-        // trigonometry, and the angle 2·atan(|Ω|Δs/2) equals |Ω|Δs to first order.
-        let half = (h * omega_h + l * omega_l + u * omega_u) * (0.5 * light * ds);
-        let rotation = glam::Quat::from_xyzw(half.x, half.y, half.z, 1.0).normalize();
-        h = rotation * h;
-        l = rotation * l;
-        position += h * ds;
+/// The constants of the petiole model and the blade, shared by every leaf.
+struct Petiole {
+    /// sin and cos of the insertion angle.
+    sin_insertion: f32,
+    cos_insertion: f32,
+    steps: u32,
+    /// Δs.
+    step_length: f32,
+    /// Tropism target T, unit.
+    target: Vec3,
+    /// e_H, e_L, e_U.
+    twist_rate: f32,
+    bend_rate: f32,
+    turn_rate: f32,
+    blade_length: f32,
+    half_width: f32,
+}
+
+impl Petiole {
+    fn new(params: &LeafParams) -> Self {
+        let (sin_insertion, cos_insertion) = params.insertion_angle.sin_cos();
+        let steps = params.petiole_steps.max(1);
+        Petiole {
+            sin_insertion,
+            cos_insertion,
+            steps,
+            step_length: params.petiole_length / steps as f32,
+            target: Vec3::from(params.light_direction)
+                .try_normalize()
+                .unwrap_or(Vec3::Y),
+            twist_rate: params.twist_rate,
+            bend_rate: params.bend_rate,
+            turn_rate: params.turn_rate,
+            blade_length: params.length,
+            half_width: 0.5 * params.width,
+        }
     }
-    let h = h.try_normalize().unwrap_or(heading);
-    let l = (l - h * l.dot(h))
-        .try_normalize()
-        .unwrap_or_else(|| any_perpendicular(h));
-    let normal = h.cross(l);
-    let half_width = l * (0.5 * params.width);
-    let tip = position + h * params.length;
+
+    /// Integrates the petiole's frame from the branch surface to the blade: the blade's base
+    /// point and its H and L axes.
+    fn integrate(&self, slot: &LeafSlot) -> (Vec3, Vec3, Vec3) {
+        let LeafSlot {
+            attachment,
+            heading,
+            radial,
+            light,
+        } = *slot;
+        let mut h = heading * self.cos_insertion + radial * self.sin_insertion;
+        let mut l = heading
+            .cross(radial)
+            .try_normalize()
+            .unwrap_or_else(|| any_perpendicular(h));
+        let target = self.target;
+        let ds = self.step_length;
+        let half_step = 0.5 * light * ds;
+        let mut position = attachment;
+        for _ in 0..self.steps {
+            let u = h.cross(l);
+            let (h_t, l_t) = (h.dot(target), l.dot(target));
+            // Ω = Ω_H·H + Ω_L·L + Ω_U·U, with L·(T × (H × T)) = L·H − (L·T)(H·T) for unit T.
+            // The rotation by the vector Ω·Δs goes through the quaternion (Ω·Δs/2, 1)
+            // normalised: no trigonometry, and its angle 2·atan(|Ω|Δs/2) equals |Ω|Δs to first
+            // order. (a, b, c) are the components of Ω·Δs/2 in the frame H, L, U.
+            let a = -self.twist_rate * l_t * half_step;
+            let b = self.bend_rate * h_t * half_step;
+            let c = self.turn_rate * (l.dot(h) - l_t * h_t) * half_step;
+            // v' = v + s·(w × v) + s·w × (w × v) with s = 2/(1 + |w|²), written out in the
+            // frame (H × L = U, L × U = H, U × H = L).
+            let s = 2.0 / (1.0 + a * a + b * b + c * c);
+            let next_h =
+                h * (1.0 - s * (b * b + c * c)) + l * (s * (c + a * b)) + u * (s * (a * c - b));
+            let next_l =
+                h * (s * (a * b - c)) + l * (1.0 - s * (a * a + c * c)) + u * (s * (a + b * c));
+            h = next_h;
+            l = next_l;
+            position += h * ds;
+        }
+        let h = h.try_normalize().unwrap_or(heading);
+        let l = (l - h * l.dot(h))
+            .try_normalize()
+            .unwrap_or_else(|| any_perpendicular(h));
+        (position, h, l)
+    }
+}
+
+fn push_leaf(mesh: &mut TreeMesh, petiole: &Petiole, slot: &LeafSlot) {
+    let (position, h, l) = petiole.integrate(slot);
+    let normal = h.cross(l).to_array();
+    let half_width = l * petiole.half_width;
+    let tip = position + h * petiole.blade_length;
     let base = mesh.positions.len() as u32;
-    mesh.push_vertex(position - half_width, normal, [0.0, 1.0], light);
-    mesh.push_vertex(position + half_width, normal, [1.0, 1.0], light);
-    mesh.push_vertex(tip - half_width, normal, [0.0, 0.0], light);
-    mesh.push_vertex(tip + half_width, normal, [1.0, 0.0], light);
+    mesh.positions.extend_from_slice(&[
+        (position - half_width).to_array(),
+        (position + half_width).to_array(),
+        (tip - half_width).to_array(),
+        (tip + half_width).to_array(),
+    ]);
+    mesh.normals.extend_from_slice(&[normal; 4]);
+    mesh.uvs
+        .extend_from_slice(&[[0.0, 1.0], [1.0, 1.0], [0.0, 0.0], [1.0, 0.0]]);
+    mesh.ambient.extend_from_slice(&[slot.light; 4]);
     // Counter-clockwise seen from the normal's side (H × L = U): base-left, tip-left, tip-right.
     mesh.indices
         .extend_from_slice(&[base, base + 2, base + 3, base, base + 3, base + 1]);

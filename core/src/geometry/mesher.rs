@@ -3,7 +3,7 @@
 //! that interactive re-meshing allocates nothing once its buffers have grown.
 
 use super::branches::RingFrames;
-use super::leaves::{self, LeafSlot};
+use super::leaves::{self, LeafScratch};
 use super::topology::BranchTopology;
 use super::{
     AmbientFn, LOD_TRIANGLE_FRACTIONS, Lod, MaterialColors, MeshParams, NodeGeom, TreeMeshes,
@@ -39,7 +39,7 @@ pub struct Mesher {
     nodes: Vec<NodeGeom>,
     topology: BranchTopology,
     frames: RingFrames,
-    slots: Vec<LeafSlot>,
+    leaf_scratch: LeafScratch,
     kept: Vec<bool>,
 }
 
@@ -67,7 +67,7 @@ impl Mesher {
             &params.leaves,
             params.seed,
             ambient,
-            &mut self.slots,
+            &mut self.leaf_scratch,
             &mut meshes.leaves,
         );
         meshes.fruit.clear();
