@@ -14,6 +14,25 @@ const MAX_RING_CANDIDATES: usize = 10;
 /// Most candidates once the 2-ring is added.
 const MAX_CANDIDATES: usize = 16;
 
+/// Flag of a vertex of all points (see `Layer::mark`): it is in the surface.
+pub(crate) const IN_SURFACE: u8 = 1;
+/// Flag: the point changed in this edit, so its standing is its lenient verdict ...
+pub(crate) const CHANGED: u8 = 2;
+/// ... which is this flag.
+pub(crate) const LENIENT: u8 = 4;
+/// Flag: observed in the current frame (set and cleared within an update).
+pub(crate) const SEEN: u8 = 8;
+
+/// How a consistency test counts support.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) enum Support {
+    /// Any 1-ring neighbours vouch (a first verdict for points without standing).
+    Lenient,
+    /// Only trusted neighbours vouch (surface members untouched by this edit, changed points
+    /// with a positive lenient verdict); the 2-ring is tried when the 1-ring fails.
+    Strict,
+}
+
 /// Reused buffers of the consistency test.
 #[derive(Default)]
 pub(crate) struct Scratch {
@@ -24,15 +43,21 @@ pub(crate) struct Scratch {
 impl DepthMesh {
     /// Whether some triangle of trusted neighbours predicts the vertex's inverse depth
     /// (inverse depth is affine in the image over a plane, so planar surfaces predict
-    /// exactly). Tries the 1-ring first, then (if asked) adds the 2-ring. `handle` is the
-    /// vertex in the layer of all points.
+    /// exactly). `handle` is the vertex in the layer of all points.
     pub(crate) fn is_supported(
         &self,
         handle: FixedVertexHandle,
-        trusted: &dyn Fn(u64) -> bool,
-        use_second_ring: bool,
+        support: Support,
         scratch: &mut Scratch,
     ) -> bool {
+        let trusted = |neighbour: FixedVertexHandle| {
+            let mark = self.all.mark(neighbour);
+            match support {
+                Support::Lenient => true,
+                Support::Strict if mark & CHANGED != 0 => mark & LENIENT != 0,
+                Support::Strict => mark & IN_SURFACE != 0,
+            }
+        };
         if self.all.handles.len() < 5 {
             return true;
         }
@@ -47,26 +72,26 @@ impl DepthMesh {
         candidates.clear();
         candidates.extend(
             ring.iter()
+                .filter(|(h, _)| trusted(*h))
                 .map(|(_, v)| *v)
-                .filter(|v| trusted(v.id))
                 .take(MAX_RING_CANDIDATES),
         );
         if self.any_triple_predicts(vertex, candidates, 0) {
             return true;
         }
-        if !use_second_ring {
+        if support == Support::Lenient {
             return false;
         }
         let num_first = candidates.len();
         for &(first, _) in ring.iter() {
-            for (_, second) in self.all.ring(first) {
+            for (second_handle, second) in self.all.ring(first) {
                 if candidates.len() >= MAX_CANDIDATES {
                     break;
                 }
                 if second.id != vertex.id
                     && !ring.iter().any(|(_, r)| r.id == second.id)
                     && !candidates.iter().any(|c| c.id == second.id)
-                    && trusted(second.id)
+                    && trusted(second_handle)
                 {
                     candidates.push(second);
                 }

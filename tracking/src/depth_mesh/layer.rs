@@ -101,6 +101,9 @@ pub(crate) struct Layer {
     pub(crate) triangles: Triangles,
     pub(crate) handles: IdMap<FixedVertexHandle>,
     positions: IdSet,
+    /// Per-vertex flags of the owner, indexed like spade's vertices (kept in step with its
+    /// swap-removal), so hot loops read them without hashing.
+    marks: Vec<u8>,
     grid: HintGrid,
 }
 
@@ -110,6 +113,7 @@ impl Layer {
             triangles: Triangles::default(),
             handles: IdMap::default(),
             positions: IdSet::default(),
+            marks: Vec::new(),
             grid: HintGrid::new(camera),
         }
     }
@@ -219,6 +223,12 @@ impl Layer {
         })?;
         self.handles.insert(vertex.id, handle);
         self.positions.insert(position_key(vertex.pixel));
+        // Spade appends new vertices (a taken position, which it would overwrite, was refused).
+        if handle.index() == self.marks.len() {
+            self.marks.push(0);
+        } else {
+            self.marks[handle.index()] = 0;
+        }
         self.note(&vertex, handle);
         Ok(handle)
     }
@@ -235,6 +245,8 @@ impl Layer {
         let last = FixedVertexHandle::from_index(self.triangles.num_vertices() - 1);
         let removed = self.triangles.remove(handle);
         self.positions.remove(&position_key(removed.pixel));
+        // Spade's removal is a swap-removal of the vertex array: mirror it.
+        self.marks.swap_remove(handle.index());
         if handle != last {
             // Spade moved the last vertex into the freed slot.
             let moved_id = self.triangles.vertex(handle).data().id;
@@ -262,8 +274,36 @@ impl Layer {
             self.note(&vertex, handle);
             return Ok(());
         }
+        let mark = self.marks[handle.index()];
         let hint = self.remove(vertex.id).and_then(|(_, neighbour)| neighbour);
-        self.insert(vertex, hint).map(|_| ())
+        let handle = self.insert(vertex, hint)?;
+        self.marks[handle.index()] = mark;
+        Ok(())
+    }
+
+    /// The flags of a vertex (see [`Layer::marks`]).
+    pub(crate) fn mark(&self, handle: FixedVertexHandle) -> u8 {
+        self.marks[handle.index()]
+    }
+
+    /// Appends the ids of the vertices lacking every flag of `bits`, then clears `bits`
+    /// everywhere (one pass over the flags, no hashing).
+    pub(crate) fn drain_unmarked(&mut self, bits: u8, ids: &mut Vec<u64>) {
+        for (index, mark) in self.marks.iter_mut().enumerate() {
+            if *mark & bits == 0 {
+                let handle = FixedVertexHandle::from_index(index);
+                ids.push(self.triangles.vertex(handle).data().id);
+            }
+            *mark &= !bits;
+        }
+    }
+
+    /// Sets (`on`) or clears the flags `bits` of the vertex of `id`, if held.
+    pub(crate) fn set_mark(&mut self, id: u64, bits: u8, on: bool) {
+        if let Some(&handle) = self.handles.get(&id) {
+            let mark = &mut self.marks[handle.index()];
+            *mark = if on { *mark | bits } else { *mark & !bits };
+        }
     }
 
     /// Sets the depth of a held vertex (its position, hence the triangulation, is unchanged).

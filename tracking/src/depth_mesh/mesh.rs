@@ -9,8 +9,8 @@
 use glam::Vec2;
 use spade::{HasPosition, Point2, Triangulation};
 
-use super::consistency::Scratch;
-use super::layer::{IdMap, IdSet, Layer};
+use super::consistency::{CHANGED, IN_SURFACE, LENIENT, SEEN, Scratch, Support};
+use super::layer::{IdSet, Layer};
 use super::{DepthMeshConfig, DepthMeshError, Observation, PinholeIntrinsics};
 
 /// A vertex: pixel position, depth and the map point it came from.
@@ -44,8 +44,6 @@ pub struct UpdateStats {
 /// Scratch state of one edit, kept between updates so that they do not allocate.
 #[derive(Default)]
 pub(crate) struct Work {
-    /// Ids observed in the current frame.
-    seen: IdSet,
     lost: Vec<u64>,
     /// Points inserted, moved or given a new depth: they have no standing in the surface yet.
     pub(crate) changed: Vec<u64>,
@@ -53,7 +51,7 @@ pub(crate) struct Work {
     pub(crate) dirty: Vec<u64>,
     dirty_set: IdSet,
     /// Lenient verdicts (any neighbours vouch) of the changed points.
-    pub(crate) lenient: IdMap<bool>,
+    pub(crate) lenient: Vec<(u64, bool)>,
     pub(crate) verdicts: Vec<(MeshVertex, bool)>,
     pub(crate) scratch: Scratch,
     reinsert: Vec<MeshVertex>,
@@ -61,7 +59,6 @@ pub(crate) struct Work {
 
 impl Work {
     fn clear(&mut self) {
-        self.seen.clear();
         self.lost.clear();
         self.changed.clear();
         self.dirty.clear();
@@ -179,10 +176,10 @@ impl DepthMesh {
     pub fn update(&mut self, observations: &[Observation]) -> UpdateStats {
         let mut stats = UpdateStats::default();
         let mut work = self.begin();
-        work.seen.extend(observations.iter().map(|o| o.id));
-        let seen = &work.seen;
-        work.lost
-            .extend(self.all.handles.keys().filter(|id| !seen.contains(id)));
+        for observation in observations {
+            self.all.set_mark(observation.id, SEEN, true);
+        }
+        self.all.drain_unmarked(SEEN, &mut work.lost);
         let lost = std::mem::take(&mut work.lost);
         for &id in &lost {
             self.remove_into(id, &mut work);
@@ -287,21 +284,21 @@ impl DepthMesh {
         } = work;
         for &id in changed.iter() {
             if let Some(&handle) = self.all.handles.get(&id) {
-                lenient.insert(id, self.is_supported(handle, &|_| true, false, scratch));
+                lenient.push((id, self.is_supported(handle, Support::Lenient, scratch)));
             }
         }
-        let surface = &self.surface;
-        let trusted = |id: u64| {
-            lenient
-                .get(&id)
-                .copied()
-                .unwrap_or_else(|| surface.handles.contains_key(&id))
-        };
+        for &(id, verdict) in lenient.iter() {
+            self.all.set_mark(id, CHANGED, true);
+            self.all.set_mark(id, LENIENT, verdict);
+        }
         for &id in dirty.iter() {
             if let Some(&handle) = self.all.handles.get(&id) {
-                let consistent = self.is_supported(handle, &trusted, true, scratch);
+                let consistent = self.is_supported(handle, Support::Strict, scratch);
                 verdicts.push((*self.all.triangles.vertex(handle).data(), consistent));
             }
+        }
+        for &(id, _) in lenient.iter() {
+            self.all.set_mark(id, CHANGED | LENIENT, false);
         }
         self.apply_verdicts(work);
     }
@@ -318,11 +315,13 @@ impl DepthMesh {
             };
             if !consistent {
                 self.surface.remove(vertex.id);
+                self.all.set_mark(vertex.id, IN_SURFACE, false);
             } else if old.pixel != vertex.pixel {
                 if self.surface.move_vertex(vertex).is_err() {
                     // Its new position still holds a surface vertex that moves away later in
                     // this loop: insert it after all moves.
                     self.surface.remove(vertex.id);
+                    self.all.set_mark(vertex.id, IN_SURFACE, false);
                     work.reinsert.push(vertex);
                 }
             } else if old.depth_m != vertex.depth_m {
@@ -331,7 +330,9 @@ impl DepthMesh {
         }
         for &vertex in &work.reinsert {
             // Every surface vertex is now at its current position, unique among all points.
-            let _ = self.surface.insert(vertex, None);
+            if self.surface.insert(vertex, None).is_ok() {
+                self.all.set_mark(vertex.id, IN_SURFACE, true);
+            }
         }
     }
 
@@ -354,6 +355,13 @@ impl DepthMesh {
                 );
             }
             super::validity::check_triangulation(&layer.triangles);
+        }
+        for (&id, &handle) in &self.all.handles {
+            assert_eq!(
+                self.all.mark(handle) & IN_SURFACE != 0,
+                self.surface.handles.contains_key(&id),
+                "surface flag of point {id}"
+            );
         }
         for &id in self.surface.handles.keys() {
             let (surface, all) = (self.surface.get(id), self.all.get(id));
