@@ -7,7 +7,7 @@ use super::*;
 /// Fixed seed for every random test input.
 const SEED: u64 = 0x5eed_de97;
 
-pub(crate) struct SplitMix(u64);
+pub(crate) struct SplitMix(pub(crate) u64);
 
 impl SplitMix {
     pub(crate) fn next_f32(&mut self) -> f32 {
