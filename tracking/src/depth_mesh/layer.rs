@@ -286,6 +286,13 @@ impl Layer {
         self.marks[handle.index()]
     }
 
+    /// Sets the flags `bits` of the vertex of `id` and returns the vertex, if held.
+    pub(crate) fn mark_seen(&mut self, id: u64, bits: u8) -> Option<MeshVertex> {
+        let handle = *self.handles.get(&id)?;
+        self.marks[handle.index()] |= bits;
+        Some(*self.triangles.vertex(handle).data())
+    }
+
     /// Appends the ids of the vertices lacking every flag of `bits`, then clears `bits`
     /// everywhere (one pass over the flags, no hashing).
     pub(crate) fn drain_unmarked(&mut self, bits: u8, ids: &mut Vec<u64>) {

@@ -45,6 +45,8 @@ pub struct UpdateStats {
 #[derive(Default)]
 pub(crate) struct Work {
     lost: Vec<u64>,
+    /// Indices of the observations that insert or change a point.
+    pending: Vec<usize>,
     /// Points inserted, moved or given a new depth: they have no standing in the surface yet.
     pub(crate) changed: Vec<u64>,
     /// Vertices whose consistency must be re-evaluated (`dirty_set` deduplicates).
@@ -60,6 +62,7 @@ pub(crate) struct Work {
 impl Work {
     fn clear(&mut self) {
         self.lost.clear();
+        self.pending.clear();
         self.changed.clear();
         self.dirty.clear();
         self.dirty_set.clear();
@@ -176,8 +179,15 @@ impl DepthMesh {
     pub fn update(&mut self, observations: &[Observation]) -> UpdateStats {
         let mut stats = UpdateStats::default();
         let mut work = self.begin();
-        for observation in observations {
-            self.all.set_mark(observation.id, SEEN, true);
+        // One look-up per observation: mark it seen, and set aside those with work to do.
+        for (index, observation) in observations.iter().enumerate() {
+            let Some(old) = self.all.mark_seen(observation.id, SEEN) else {
+                work.pending.push(index);
+                continue;
+            };
+            if !(self.validate(observation).is_ok() && self.is_unchanged(&old, observation)) {
+                work.pending.push(index);
+            }
         }
         self.all.drain_unmarked(SEEN, &mut work.lost);
         let lost = std::mem::take(&mut work.lost);
@@ -186,14 +196,16 @@ impl DepthMesh {
         }
         stats.num_removed = lost.len();
         work.lost = lost;
-        for observation in observations {
-            match self.insert_or_move(*observation, &mut work) {
+        let pending = std::mem::take(&mut work.pending);
+        for &index in &pending {
+            match self.insert_or_move(observations[index], &mut work) {
                 Ok(Change::Inserted) => stats.num_inserted += 1,
                 Ok(Change::Moved) => stats.num_moved += 1,
                 Ok(Change::None) => {}
                 Err(_) => stats.num_rejected += 1,
             }
         }
+        work.pending = pending;
         self.finish(work);
         stats.num_inconsistent = self.num_points() - self.num_surface_points();
         stats
@@ -233,6 +245,13 @@ impl DepthMesh {
         true
     }
 
+    /// Whether an observation of a held point leaves its vertex as it is: it moved at most
+    /// the move tolerance and its depth changed by at most 0.1 %.
+    fn is_unchanged(&self, old: &MeshVertex, observation: &Observation) -> bool {
+        old.pixel.distance(observation.pixel) <= self.config.move_tolerance_px
+            && (old.depth_m - observation.depth_m).abs() <= 1e-3 * old.depth_m
+    }
+
     fn insert_or_move(
         &mut self,
         observation: Observation,
@@ -245,11 +264,10 @@ impl DepthMesh {
             self.mark_with_neighbours(vertex.id, work);
             return Ok(Change::Inserted);
         };
-        let moved = old.pixel.distance(vertex.pixel) > self.config.move_tolerance_px;
-        let relative = (old.depth_m - vertex.depth_m).abs() / old.depth_m;
-        if !moved && relative <= 1e-3 {
+        if self.is_unchanged(&old, &observation) {
             return Ok(Change::None);
         }
+        let moved = old.pixel.distance(vertex.pixel) > self.config.move_tolerance_px;
         if moved {
             // Neighbours before the move lose or change a neighbour too.
             for n in self.all.neighbours(vertex.id) {
