@@ -102,6 +102,9 @@ pub(crate) struct RingFrames {
     /// chain index in the low 32 bits. Sorted on demand by the coarser levels.
     by_diameter: Vec<u64>,
     tables: SideTables,
+    /// The internodes of every chain in chain order (`BranchTopology::chain_nodes`): the rings
+    /// walk chains, which jump around the arena, so they read this gathered copy.
+    chain_geometry: Vec<NodeGeom>,
 }
 
 /// Sides C = 3·dⁿ/d_e (eq. C.2) of a branch of base diameter `d`, clamped to [3, max].
@@ -112,6 +115,10 @@ fn contour_sides(diameter: f32, thinnest: f32, exponent: f32, max_sides: u32) ->
 
 /// Sides of a chain at a level of detail drawn with `side_scale` of the finest sides.
 fn scaled_sides(sides: u32, side_scale: f32) -> u32 {
+    if side_scale == 1.0 {
+        // The finest level, without a call to `round` (not an instruction on baseline x86-64).
+        return sides.max(3);
+    }
     ((sides as f32 * side_scale).round() as u32).max(3)
 }
 
@@ -129,9 +136,39 @@ fn end_radius(nodes: &[NodeGeom], topology: &BranchTopology, node: u32, tip_tape
 #[derive(Clone, Copy, Debug)]
 struct TubeSegment {
     a: Vec3,
-    b: Vec3,
+    /// b − a.
+    ab: Vec3,
+    /// 1 / |b − a|², 0 for a degenerate segment.
+    inverse_length_squared: f32,
     radius_a: f32,
+    /// radius_b − radius_a.
+    radius_change: f32,
     radius_b: f32,
+}
+
+impl TubeSegment {
+    fn new(a: Vec3, b: Vec3, radius_a: f32, radius_b: f32) -> Self {
+        let ab = b - a;
+        let length_squared = ab.length_squared();
+        TubeSegment {
+            a,
+            ab,
+            inverse_length_squared: if length_squared > 1e-12 {
+                1.0 / length_squared
+            } else {
+                0.0
+            },
+            radius_a,
+            radius_change: radius_b - radius_a,
+            radius_b,
+        }
+    }
+
+    /// The axis point closest to `point` and the tube radius there.
+    fn closest(&self, point: Vec3) -> (Vec3, f32) {
+        let t = ((point - self.a).dot(self.ab) * self.inverse_length_squared).clamp(0.0, 1.0);
+        (self.a + self.ab * t, self.radius_a + self.radius_change * t)
+    }
 }
 
 /// The parent surface near a branching point, as the parent's rings draw it: the internode the
@@ -146,12 +183,8 @@ impl ParentTube {
     fn new(nodes: &[NodeGeom], topology: &BranchTopology, parent: u32, tip_taper: f32) -> Self {
         let segment = |node: u32| {
             let n = &nodes[node as usize];
-            TubeSegment {
-                a: n.start,
-                b: n.end,
-                radius_a: 0.5 * n.diameter,
-                radius_b: end_radius(nodes, topology, node, tip_taper),
-            }
+            let radius_b = end_radius(nodes, topology, node, tip_taper);
+            TubeSegment::new(n.start, n.end, 0.5 * n.diameter, radius_b)
         };
         let continuation = topology.visual_child[parent as usize];
         ParentTube {
@@ -167,11 +200,10 @@ impl ParentTube {
 
     /// The axis point closest to `point` and the tube radius there.
     fn at(&self, point: Vec3) -> (Vec3, f32) {
-        let s = &self.below;
-        let best = closest_on_segment(s.a, s.b, s.radius_a, s.radius_b, point);
+        let best = self.below.closest(point);
         match &self.above {
             Some(s) => {
-                let candidate = closest_on_segment(s.a, s.b, s.radius_a, s.radius_b, point);
+                let candidate = s.closest(point);
                 if candidate.0.distance_squared(point) < best.0.distance_squared(point) {
                     candidate
                 } else {
@@ -181,17 +213,6 @@ impl ParentTube {
             None => best,
         }
     }
-}
-
-fn closest_on_segment(a: Vec3, b: Vec3, radius_a: f32, radius_b: f32, point: Vec3) -> (Vec3, f32) {
-    let ab = b - a;
-    let length_squared = ab.length_squared();
-    let t = if length_squared > 1e-12 {
-        ((point - a).dot(ab) / length_squared).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (a + ab * t, radius_a + (radius_b - radius_a) * t)
 }
 
 /// Carries `reference` from a ring at `from` with tangent `from_tangent` to the next ring by the
@@ -239,13 +260,17 @@ impl RingFrames {
             self.tables = SideTables::new(max_sides);
         }
         let (rings, chains) = (&mut self.rings, &mut self.chains);
+        let chain_geometry = &mut self.chain_geometry;
+        chain_geometry.clear();
+        chain_geometry.extend(topology.chain_nodes.iter().map(|&n| nodes[n as usize]));
         rings.clear();
         rings.reserve(nodes.len() + topology.chains.len());
         chains.clear();
         chains.reserve(topology.chains.len());
         for (chain_index, chain) in topology.chains.iter().enumerate() {
             let chain_nodes = topology.nodes_of(chain_index);
-            let raw_diameter = nodes[chain_nodes[0] as usize].diameter;
+            let geometry = &chain_geometry[chain.first as usize..][..chain_nodes.len()];
+            let raw_diameter = geometry[0].diameter;
             let base_diameter = raw_diameter.max(1e-5);
             let circumference = PI * base_diameter;
             let tiles_around = (circumference / params.bark_tile_size.max(1e-4))
@@ -256,7 +281,7 @@ impl RingFrames {
                 .then(|| ParentTube::new(nodes, topology, chain.parent_node, params.tip_taper));
             push_chain_rings(
                 rings,
-                nodes,
+                geometry,
                 tube.as_ref(),
                 chain_nodes,
                 params,
@@ -389,29 +414,36 @@ impl RingFrames {
             &self.rings[chain.first_ring as usize..(chain.first_ring + chain.num_rings) as usize];
         let du = chain.tiles_around / sides as f32;
         let ring_size = sides as usize + 1;
+        let laid = chain.tube.as_ref().zip(shrink);
         for (ring_index, ring) in rings.iter().enumerate() {
             let base = mesh.positions.len() as u32;
-            let direction = |&(cos, sin): &(f32, f32)| ring.reference * cos + ring.binormal * sin;
-            match (chain.tube.as_ref(), shrink) {
-                (Some(tube), Some(shrink)) if ring_index == 0 => {
-                    mesh.positions.extend(
-                        table
-                            .iter()
-                            .map(|cs| onto_parent(tube, ring, direction(cs), shrink).to_array()),
-                    );
+            let (reference, binormal) = (ring.reference, ring.binormal);
+            match laid {
+                Some((tube, shrink)) if ring_index == 0 => {
+                    for (k, &(cos, sin)) in table.iter().enumerate() {
+                        let direction = reference * cos + binormal * sin;
+                        let position = onto_parent(tube, ring, direction, shrink);
+                        mesh.push_vertex(
+                            position,
+                            direction,
+                            [k as f32 * du + ring.u_offset, ring.v],
+                            ring.ambient,
+                        );
+                    }
                 }
-                _ => mesh.positions.extend(
-                    table
-                        .iter()
-                        .map(|cs| (ring.center + direction(cs) * ring.radius).to_array()),
-                ),
+                _ => {
+                    for (k, &(cos, sin)) in table.iter().enumerate() {
+                        let direction = reference * cos + binormal * sin;
+                        let position = ring.center + direction * ring.radius;
+                        mesh.push_vertex(
+                            position,
+                            direction,
+                            [k as f32 * du + ring.u_offset, ring.v],
+                            ring.ambient,
+                        );
+                    }
+                }
             }
-            mesh.normals
-                .extend(table.iter().map(|cs| direction(cs).to_array()));
-            mesh.uvs
-                .extend((0..ring_size).map(|k| [k as f32 * du + ring.u_offset, ring.v]));
-            mesh.ambient
-                .extend(std::iter::repeat_n(ring.ambient, ring_size));
             if ring_index > 0 {
                 let below = base - ring_size as u32;
                 mesh.indices
@@ -460,14 +492,14 @@ fn chain_triangles(chain: &ChainRings, side_scale: f32) -> usize {
 #[allow(clippy::too_many_arguments)]
 fn push_chain_rings(
     rings: &mut Vec<Ring>,
-    nodes: &[NodeGeom],
+    geometry: &[NodeGeom],
     tube: Option<&ParentTube>,
     chain_nodes: &[u32],
     params: &MeshParams,
     tile_length: f32,
     ambient: AmbientFn,
 ) {
-    let first = &nodes[chain_nodes[0] as usize];
+    let first = &geometry[0];
     let mut previous = Ring {
         center: first.start,
         tangent: first.heading,
@@ -488,18 +520,14 @@ fn push_chain_rings(
     rings.push(previous);
     let mut inside_parent = tube.is_some();
     let mut arc_length = 0.0;
-    for (k, &node_index) in chain_nodes.iter().enumerate() {
-        let node = &nodes[node_index as usize];
+    for (k, (node, &node_index)) in geometry.iter().zip(chain_nodes).enumerate() {
         let heading = node.heading;
         arc_length += node.length;
-        let (tangent, radius) = match chain_nodes.get(k + 1) {
-            Some(&next) => {
-                let next = &nodes[next as usize];
-                (
-                    (heading + next.heading).try_normalize().unwrap_or(heading),
-                    0.5 * next.diameter,
-                )
-            }
+        let (tangent, radius) = match geometry.get(k + 1) {
+            Some(next) => (
+                (heading + next.heading).try_normalize().unwrap_or(heading),
+                0.5 * next.diameter,
+            ),
             None => (heading, 0.5 * node.diameter * params.tip_taper),
         };
         if let Some(tube) = tube.filter(|_| inside_parent) {

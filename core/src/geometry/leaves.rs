@@ -14,6 +14,7 @@
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
+use super::petiole::{Attachment, Blade, Petiole};
 use super::{AmbientFn, NodeGeom, TreeMesh, any_perpendicular, hash_unit};
 use crate::rng::Rng;
 use crate::tree::Skeleton;
@@ -87,19 +88,6 @@ impl Default for FruitParams {
     }
 }
 
-/// A leaf to be made: the internode, position along it (0..1) and spiral angle.
-#[derive(Clone, Copy)]
-pub(crate) struct LeafSlot {
-    /// Where the petiole leaves the branch surface.
-    attachment: Vec3,
-    /// The branch heading there.
-    heading: Vec3,
-    /// Unit direction from the branch axis to the attachment.
-    radial: Vec3,
-    /// Ambient light at the attachment.
-    light: f32,
-}
-
 /// All leaves of the skeleton as quads (4 vertices, 6 indices each) in random order.
 pub fn build_leaves(
     skeleton: &Skeleton,
@@ -118,7 +106,7 @@ pub fn build_leaves(
 /// Working memory of [`build_leaves_into`]: the leaf slots.
 #[derive(Default)]
 pub(crate) struct LeafScratch {
-    slots: Vec<LeafSlot>,
+    slots: Vec<Attachment>,
 }
 
 /// [`build_leaves`] into `mesh` (cleared first, capacity reused), with `scratch` as working
@@ -166,8 +154,8 @@ pub(crate) fn build_leaves_into(
             let radial = left * spiral.0 + up * spiral.1;
             let along = (k as f32 + 0.5) / count as f32;
             let attachment = node.start.lerp(node.end, along) + radial * (0.5 * node.diameter);
-            let slot = LeafSlot {
-                attachment,
+            let slot = Attachment {
+                point: attachment,
                 heading,
                 radial,
                 light: ambient(attachment).clamp(0.0, 1.0),
@@ -182,112 +170,34 @@ pub(crate) fn build_leaves_into(
     mesh.clear();
     mesh.reserve(slots.len() * 4, slots.len() * 6);
     let petiole = Petiole::new(params);
-    for slot in slots.iter() {
-        push_leaf(mesh, &petiole, slot);
-    }
-}
-
-/// The constants of the petiole model and the blade, shared by every leaf.
-struct Petiole {
-    /// sin and cos of the insertion angle.
-    sin_insertion: f32,
-    cos_insertion: f32,
-    steps: u32,
-    /// Δs.
-    step_length: f32,
-    /// Tropism target T, unit.
-    target: Vec3,
-    /// e_H, e_L, e_U.
-    twist_rate: f32,
-    bend_rate: f32,
-    turn_rate: f32,
-    blade_length: f32,
-    half_width: f32,
-}
-
-impl Petiole {
-    fn new(params: &LeafParams) -> Self {
-        let (sin_insertion, cos_insertion) = params.insertion_angle.sin_cos();
-        let steps = params.petiole_steps.max(1);
-        Petiole {
-            sin_insertion,
-            cos_insertion,
-            steps,
-            step_length: params.petiole_length / steps as f32,
-            target: Vec3::from(params.light_direction)
-                .try_normalize()
-                .unwrap_or(Vec3::Y),
-            twist_rate: params.twist_rate,
-            bend_rate: params.bend_rate,
-            turn_rate: params.turn_rate,
-            blade_length: params.length,
-            half_width: 0.5 * params.width,
+    let mut groups = slots.chunks_exact(4);
+    for group in &mut groups {
+        let group: &[Attachment; 4] = group.try_into().expect("chunks of 4");
+        match petiole.blades4(group) {
+            Some(blades) => {
+                for (slot, blade) in group.iter().zip(&blades) {
+                    push_blade(mesh, blade, slot.light);
+                }
+            }
+            None => {
+                for slot in group {
+                    push_blade(mesh, &petiole.blade(slot), slot.light);
+                }
+            }
         }
     }
-
-    /// Integrates the petiole's frame from the branch surface to the blade: the blade's base
-    /// point and its H and L axes.
-    fn integrate(&self, slot: &LeafSlot) -> (Vec3, Vec3, Vec3) {
-        let LeafSlot {
-            attachment,
-            heading,
-            radial,
-            light,
-        } = *slot;
-        let mut h = heading * self.cos_insertion + radial * self.sin_insertion;
-        let mut l = heading
-            .cross(radial)
-            .try_normalize()
-            .unwrap_or_else(|| any_perpendicular(h));
-        let target = self.target;
-        let ds = self.step_length;
-        let half_step = 0.5 * light * ds;
-        let mut position = attachment;
-        for _ in 0..self.steps {
-            let u = h.cross(l);
-            let (h_t, l_t) = (h.dot(target), l.dot(target));
-            // Ω = Ω_H·H + Ω_L·L + Ω_U·U, with L·(T × (H × T)) = L·H − (L·T)(H·T) for unit T.
-            // The rotation by the vector Ω·Δs goes through the quaternion (Ω·Δs/2, 1)
-            // normalised: no trigonometry, and its angle 2·atan(|Ω|Δs/2) equals |Ω|Δs to first
-            // order. (a, b, c) are the components of Ω·Δs/2 in the frame H, L, U.
-            let a = -self.twist_rate * l_t * half_step;
-            let b = self.bend_rate * h_t * half_step;
-            let c = self.turn_rate * (l.dot(h) - l_t * h_t) * half_step;
-            // v' = v + s·(w × v) + s·w × (w × v) with s = 2/(1 + |w|²), written out in the
-            // frame (H × L = U, L × U = H, U × H = L).
-            let s = 2.0 / (1.0 + a * a + b * b + c * c);
-            let next_h =
-                h * (1.0 - s * (b * b + c * c)) + l * (s * (c + a * b)) + u * (s * (a * c - b));
-            let next_l =
-                h * (s * (a * b - c)) + l * (1.0 - s * (a * a + c * c)) + u * (s * (a + b * c));
-            h = next_h;
-            l = next_l;
-            position += h * ds;
-        }
-        let h = h.try_normalize().unwrap_or(heading);
-        let l = (l - h * l.dot(h))
-            .try_normalize()
-            .unwrap_or_else(|| any_perpendicular(h));
-        (position, h, l)
+    for slot in groups.remainder() {
+        push_blade(mesh, &petiole.blade(slot), slot.light);
     }
 }
 
-fn push_leaf(mesh: &mut TreeMesh, petiole: &Petiole, slot: &LeafSlot) {
-    let (position, h, l) = petiole.integrate(slot);
-    let normal = h.cross(l).to_array();
-    let half_width = l * petiole.half_width;
-    let tip = position + h * petiole.blade_length;
+fn push_blade(mesh: &mut TreeMesh, blade: &Blade, light: f32) {
     let base = mesh.positions.len() as u32;
-    mesh.positions.extend_from_slice(&[
-        (position - half_width).to_array(),
-        (position + half_width).to_array(),
-        (tip - half_width).to_array(),
-        (tip + half_width).to_array(),
-    ]);
-    mesh.normals.extend_from_slice(&[normal; 4]);
+    mesh.positions.extend_from_slice(&blade.corners);
+    mesh.normals.extend_from_slice(&[blade.normal; 4]);
     mesh.uvs
         .extend_from_slice(&[[0.0, 1.0], [1.0, 1.0], [0.0, 0.0], [1.0, 0.0]]);
-    mesh.ambient.extend_from_slice(&[slot.light; 4]);
+    mesh.ambient.extend_from_slice(&[light; 4]);
     // Counter-clockwise seen from the normal's side (H × L = U): base-left, tip-left, tip-right.
     mesh.indices
         .extend_from_slice(&[base, base + 2, base + 3, base, base + 3, base + 1]);
@@ -321,8 +231,9 @@ pub fn build_fruit_into(
         }
         let light = node.light_exposure.clamp(0.0, 1.0);
         let buds = node.terminal_bud.iter().chain(node.lateral_buds.iter());
+        let node_hash = position_hash(node.end);
         for (k, bud) in buds.enumerate().filter(|(_, b)| b.alive) {
-            let r = hash_unit(position_hash(node.end) ^ ((k as u64) << 48) ^ index as u64);
+            let r = hash_unit(node_hash ^ ((k as u64) << 48) ^ index as u64);
             if r * light * light <= params.threshold {
                 continue;
             }

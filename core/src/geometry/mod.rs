@@ -22,6 +22,7 @@ mod branches;
 pub mod leaves;
 mod looks;
 mod mesher;
+mod petiole;
 pub mod synthetic;
 pub mod textures;
 pub mod topology;
