@@ -8,6 +8,7 @@ use glam::Vec2;
 
 use crate::footage::Footage;
 use crate::player::DEFAULT_SEED;
+use crate::scene_tracking::SceneTracker;
 use crate::session::{Session, frame_camera, frame_dt};
 use crate::state::{DesignState, InputEvent, Parameters, TouchPhase};
 
@@ -30,6 +31,7 @@ pub fn demo_session(footage: &Footage, footage_ref: PathBuf) -> anyhow::Result<S
     let at = |fraction: f32| (fraction * n as f32) as usize;
     let mut stroke_pixel = Vec2::ZERO;
     let mut bend_pixel = Vec2::ZERO;
+    let mut tracker = SceneTracker::open(&footage.root, footage.intrinsics)?;
     for index in 0..n {
         let step = index;
         let mut events = Vec::new();
@@ -117,7 +119,7 @@ pub fn demo_session(footage: &Footage, footage_ref: PathBuf) -> anyhow::Result<S
             state.apply(&e);
             session.record(e);
         }
-        session.push_frame(footage, index);
+        session.push_frame(footage, index, tracker.frame(index)?);
         let Some(record) = session.frames.last() else {
             continue;
         };

@@ -11,7 +11,7 @@ use winit::event::WindowEvent;
 use winit::event_loop::{ActiveEventLoop, EventLoop};
 use winit::window::{Window, WindowId};
 
-use crate::footage::{Footage, occluder_from_depth};
+use crate::footage::Footage;
 use crate::player::Player;
 use crate::render::{FrameView, Gpu, Renderer};
 
@@ -45,7 +45,7 @@ pub fn run_window(
 ) -> anyhow::Result<()> {
     let event_loop = EventLoop::new().context("cannot connect to a display")?;
     event_loop.set_control_flow(winit::event_loop::ControlFlow::Poll);
-    let mut player = Player::new(footage, footage_ref);
+    let mut player = Player::new(footage, footage_ref)?;
     player.frame = first_frame.min(player.footage.len().saturating_sub(1));
     player.ui.playing = !paused;
     let mut app = DesktopApp {
@@ -200,15 +200,8 @@ impl DesktopApp {
                     self.player.footage.intrinsics,
                 );
             }
-            if let Some(depth) = &self.player.depth {
-                let occluder = occluder_from_depth(
-                    depth,
-                    &self.player.footage.intrinsics,
-                    camera.world_from_camera,
-                    8,
-                );
-                gfx.renderer.set_occluder(&gfx.gpu, &occluder);
-            }
+            gfx.renderer
+                .set_occluder(&gfx.gpu, &self.player.scene.occluder);
             let mut view = FrameView::augmented(camera, self.player.ground());
             view.debug.depth_wireframe = self.player.ui.show_debug;
             view.debug.brush = self.player.brush_sphere();

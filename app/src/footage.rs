@@ -1,9 +1,9 @@
 //! Recorded footage in the TUM RGB-D layout (`rgb.txt`, `depth.txt`, `groundtruth.txt`,
 //! `camera.txt`) as the app plays it.
 //!
-//! TEMPORARY STAND-IN: until `sylva_tracking`'s tracker is wired in, each frame's
-//! `world_from_camera` is the ground-truth pose nearest in time (world: metres, Y up, origin at the
-//! planting spot, as the synthetic demo writes it).
+//! Each frame also carries the ground-truth pose nearest in time when the footage has one
+//! (`groundtruth.txt`): tests compare the app against it. The app itself places the camera with
+//! the tracker ([`crate::scene_tracking`]), never with the ground truth.
 
 use std::path::{Path, PathBuf};
 
@@ -18,6 +18,7 @@ pub struct FootageFrame {
     pub time_s: f64,
     pub rgb: PathBuf,
     pub depth: Option<PathBuf>,
+    /// Ground-truth `world_from_camera` (for tests and comparisons; the app tracks its own).
     pub world_from_camera: Option<Mat4>,
 }
 
@@ -186,52 +187,6 @@ fn nearest<T>(items: &[(f64, T)], t: f64, max_gap_s: f64) -> Option<&(f64, T)> {
         .filter_map(|j| items.get(j))
         .filter(|(ti, _)| (ti - t).abs() <= max_gap_s)
         .min_by(|a, b| (a.0 - t).abs().total_cmp(&(b.0 - t).abs()))
-}
-
-/// TEMPORARY STAND-IN for `sylva_tracking::depth_mesh`: the scene surface from one depth map, a
-/// grid of back-projected samples every `step` pixels, with triangles across depth jumps dropped.
-pub fn occluder_from_depth(
-    depth: &(u32, u32, Vec<f32>),
-    intrinsics: &Intrinsics,
-    world_from_camera: Mat4,
-    step: u32,
-) -> crate::render::OccluderMesh {
-    let (w, h, values) = depth;
-    let k = intrinsics.scaled_to(*w, *h);
-    let (nx, ny) = (w / step + 1, h / step + 1);
-    let mut mesh = crate::render::OccluderMesh::default();
-    let mut depths = Vec::with_capacity((nx * ny) as usize);
-    for j in 0..ny {
-        for i in 0..nx {
-            let (x, y) = ((i * step).min(w - 1), (j * step).min(h - 1));
-            let z = values[(y * w + x) as usize];
-            let ray = k.ray_from_pixel(glam::Vec2::new(x as f32, y as f32));
-            mesh.positions
-                .push(world_from_camera.transform_point3(ray * z.max(1e-3)));
-            depths.push(z);
-        }
-    }
-    for j in 0..ny - 1 {
-        for i in 0..nx - 1 {
-            let q = [
-                j * nx + i,
-                j * nx + i + 1,
-                (j + 1) * nx + i + 1,
-                (j + 1) * nx + i,
-            ];
-            for tri in [[q[0], q[1], q[2]], [q[0], q[2], q[3]]] {
-                let z = tri.map(|v| depths[v as usize]);
-                let (lo, hi) = (
-                    z.iter().copied().fold(f32::MAX, f32::min),
-                    z.iter().copied().fold(0.0, f32::max),
-                );
-                if lo > 0.0 && hi < lo * 1.08 {
-                    mesh.indices.extend(tri);
-                }
-            }
-        }
-    }
-    mesh
 }
 
 #[cfg(test)]

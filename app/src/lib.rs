@@ -12,6 +12,7 @@ pub mod desktop;
 pub mod footage;
 pub mod player;
 pub mod render;
+pub mod scene_tracking;
 pub mod session;
 pub mod state;
 #[cfg(not(any(target_os = "android", target_os = "ios")))]

@@ -9,14 +9,13 @@ use image::RgbaImage;
 
 use crate::footage::Footage;
 use crate::render::{GroundPlane, ViewCamera};
+use crate::scene_tracking::{SceneFrame, SceneTracker};
 use crate::session::{Session, frame_dt};
 use crate::state::{DesignState, InputEvent, Parameters};
 use crate::ui::UiState;
 
 /// Seed of trees planted by the app.
 pub const DEFAULT_SEED: u64 = 7;
-/// Seconds with a pose before the seedling is planted (coaching overlay shown).
-const SECONDS_TO_FIND_GROUND: f64 = 0.5;
 
 /// Footage playback, the design and the session being recorded.
 pub struct Player {
@@ -26,42 +25,45 @@ pub struct Player {
     pub session: Session,
     pub frame: usize,
     pub image: Option<RgbaImage>,
-    pub depth: Option<(u32, u32, Vec<f32>)>,
+    /// Tracking, ground plane and depth mesh of the frame shown.
+    pub scene: SceneFrame,
+    tracker: SceneTracker,
     last_tick_s: Option<f64>,
     frame_clock_s: f64,
-    first_pose_s: Option<f64>,
 }
 
 impl Player {
-    pub fn new(footage: Footage, footage_ref: PathBuf) -> Player {
+    /// A player over `footage` (recorded in sessions as `footage_ref`), tracking it as it plays.
+    pub fn new(footage: Footage, footage_ref: PathBuf) -> anyhow::Result<Player> {
         let params = Parameters::default();
         let ui = UiState {
             num_frames: footage.len(),
             ..UiState::default()
         };
-        Player {
+        let tracker = SceneTracker::open(&footage.root, footage.intrinsics)?;
+        Ok(Player {
             session: Session::new(footage_ref, DEFAULT_SEED, params.clone()),
             design: DesignState::new(DEFAULT_SEED, params),
             footage,
             ui,
             frame: 0,
             image: None,
-            depth: None,
+            scene: SceneFrame::default(),
+            tracker,
             last_tick_s: None,
             frame_clock_s: 0.0,
-            first_pose_s: None,
-        }
+        })
     }
 
-    /// The camera of the current frame.
+    /// The tracked camera of the current frame.
     pub fn camera(&self) -> Option<ViewCamera> {
-        let m = self.footage.frames.get(self.frame)?.world_from_camera?;
+        let m = self.scene.world_from_camera?;
         Some(ViewCamera::new(self.footage.intrinsics, m))
     }
 
-    /// The ground plane once found (the coaching overlay shows until then).
+    /// The ground plane once the tracker found it (the coaching overlay shows until then).
     pub fn ground(&self) -> Option<GroundPlane> {
-        self.ui.ground_found.then(GroundPlane::default)
+        self.scene.ground
     }
 
     /// The brush sphere at the finger while painting.
@@ -87,8 +89,11 @@ impl Player {
         self.frame = index;
         self.ui.frame = index;
         self.image = Some(self.footage.load_rgba(index)?);
-        self.depth = self.footage.load_depth_m(index)?;
-        self.session.push_frame(&self.footage, index);
+        let tracking_started = std::time::Instant::now();
+        self.scene = self.tracker.frame(index)?.clone();
+        self.ui.budget.tracking_ms = tracking_started.elapsed().as_secs_f32() * 1000.0;
+        self.ui.ground_found = self.scene.ground.is_some();
+        self.session.push_frame(&self.footage, index, &self.scene);
         let time_s = self.footage.frames[index].time_s;
         let started = std::time::Instant::now();
         self.design
@@ -99,12 +104,6 @@ impl Player {
 
     /// Advances playback to wall-clock `now_s` (30 Hz footage, looping), honouring pause/seek.
     pub fn tick(&mut self, now_s: f64) -> anyhow::Result<()> {
-        // TEMPORARY STAND-IN for the tracker's plane detection: the ground counts as found after
-        // a short run of updates with a camera pose.
-        if self.camera().is_some() {
-            let first = *self.first_pose_s.get_or_insert(now_s);
-            self.ui.ground_found |= now_s - first >= SECONDS_TO_FIND_GROUND;
-        }
         if let Some(target) = self.ui.seek_to.take() {
             return self.show_frame(target);
         }

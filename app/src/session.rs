@@ -9,9 +9,10 @@ use anyhow::{Context, bail};
 use glam::Mat4;
 use serde::{Deserialize, Serialize};
 
-use crate::footage::{Footage, occluder_from_depth};
+use crate::footage::Footage;
 use crate::render::offscreen::OFFSCREEN_FORMAT;
 use crate::render::{FrameView, Gpu, GroundPlane, Offscreen, Renderer, ViewCamera};
+use crate::scene_tracking::{SceneFrame, SceneTracker};
 use crate::state::{DesignState, InputEvent, Parameters};
 
 pub const SESSION_FORMAT: &str = "sylva-session";
@@ -67,15 +68,19 @@ impl Session {
     }
 
     /// Records that footage frame `index` was shown next, with its tracking output.
-    pub fn push_frame(&mut self, footage: &Footage, index: usize) {
+    pub fn push_frame(&mut self, footage: &Footage, index: usize, scene: &SceneFrame) {
         let Some(frame) = footage.frames.get(index) else {
             return;
         };
         self.frames.push(FrameRecord {
             index,
             time_s: frame.time_s,
-            world_from_camera: frame.world_from_camera.map(|m| m.to_cols_array()),
-            ground: Some([0.0, 0.0, 0.0, 0.0, 1.0, 0.0]),
+            world_from_camera: scene.world_from_camera.map(|m| m.to_cols_array()),
+            ground: scene.ground.map(|g| {
+                [
+                    g.point.x, g.point.y, g.point.z, g.normal.x, g.normal.y, g.normal.z,
+                ]
+            }),
         });
     }
 
@@ -162,6 +167,12 @@ pub fn replay(
     } else {
         None
     };
+    // Poses and the ground come from the recording; the occluding depth mesh is rebuilt by
+    // tracking the footage again (the tracker is deterministic).
+    let mut tracker = match render {
+        true => Some(SceneTracker::open(&footage.root, footage.intrinsics)?),
+        false => None,
+    };
     let mut state = DesignState::new(session.seed, session.parameters.clone());
     let mut meshed_revision = None;
     let mut frame_sha256 = Vec::new();
@@ -178,7 +189,19 @@ pub fn replay(
         previous_time = record.time_s;
         state.advance_frame(camera, record.time_s, dt);
         on_frame(step, &state);
-        let (Some((gpu, renderer, target)), Some(camera)) = (gpu_parts.as_mut(), camera) else {
+        let Some((gpu, renderer, target)) = gpu_parts.as_mut() else {
+            continue;
+        };
+        let Some(camera) = camera else {
+            // Tracking not (yet) there: the frame is the footage alone, as the app shows it.
+            let rgba = footage.load_rgba(index)?;
+            let image = image::imageops::resize(
+                &rgba,
+                session.frame_size[0],
+                session.frame_size[1],
+                image::imageops::FilterType::Triangle,
+            );
+            write_frame(&image, step, out, &mut frame_sha256)?;
             continue;
         };
         if meshed_revision != Some(state.revision) {
@@ -187,25 +210,15 @@ pub fn replay(
         }
         let rgba = footage.load_rgba(index)?;
         renderer.set_camera_image(gpu, rgba.as_raw(), footage.intrinsics);
-        if let Some(depth) = footage.load_depth_m(index)? {
-            renderer.set_occluder(
-                gpu,
-                &occluder_from_depth(&depth, &footage.intrinsics, camera.world_from_camera, 8),
-            );
+        if let Some(tracker) = tracker.as_mut() {
+            renderer.set_occluder(gpu, &tracker.frame(index)?.occluder);
         }
         let ground = record.ground.map(|g| GroundPlane {
             point: glam::Vec3::new(g[0], g[1], g[2]),
             normal: glam::Vec3::new(g[3], g[4], g[5]),
         });
         let image = target.render(gpu, renderer, &FrameView::augmented(camera, ground))?;
-        use sha2::Digest;
-        frame_sha256.push(format!("{:x}", sha2::Sha256::digest(image.as_raw())));
-        if let Some(out) = out {
-            let path = out.join(format!("frame_{step:04}.png"));
-            image
-                .save(&path)
-                .with_context(|| format!("cannot write {}", path.display()))?;
-        }
+        write_frame(&image, step, out, &mut frame_sha256)?;
     }
     let num_frames = session.frames.len();
     let ms_per_frame = started.elapsed().as_secs_f64() * 1000.0 / num_frames.max(1) as f64;
@@ -218,6 +231,24 @@ pub fn replay(
         num_frames,
         ms_per_frame,
     })
+}
+
+/// Hashes a replayed frame and writes it as `frame_NNNN.png` into `out` when given.
+fn write_frame(
+    image: &image::RgbaImage,
+    step: usize,
+    out: Option<&Path>,
+    frame_sha256: &mut Vec<String>,
+) -> anyhow::Result<()> {
+    use sha2::Digest;
+    frame_sha256.push(format!("{:x}", sha2::Sha256::digest(image.as_raw())));
+    if let Some(out) = out {
+        let path = out.join(format!("frame_{step:04}.png"));
+        image
+            .save(&path)
+            .with_context(|| format!("cannot write {}", path.display()))?;
+    }
+    Ok(())
 }
 
 /// Time step between two shown frames: the footage's, or one 30 Hz frame when playback looped

@@ -1,0 +1,200 @@
+//! The real scene behind the footage, as the app sees it: camera poses and the ground plane from
+//! `sylva_tracking`'s monocular tracker, and the occluding surface from its incremental depth
+//! mesh of the tracked points.
+//!
+//! The tracker is causal: frame k is tracked after frames 0..k. Each frame is tracked once, in
+//! order, and its result kept, so looping playback, seeking back and replays read the cache and
+//! seeking forward tracks the frames in between. World: metres, Y up, origin on the ground plane
+//! (fixed once the plane is found, so a planted tree never moves).
+
+use std::path::Path;
+
+use glam::Mat4;
+
+use crate::render::{GroundPlane, Intrinsics, OccluderMesh};
+
+/// What the app knows about the scene at one frame.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct SceneFrame {
+    /// `world_from_camera`; None while tracking is lost or not initialised.
+    pub world_from_camera: Option<Mat4>,
+    /// The ground plane once found.
+    pub ground: Option<GroundPlane>,
+    /// The depth mesh of the tracked points in the world (empty without a pose).
+    pub occluder: OccluderMesh,
+    /// Map points tracked in this frame.
+    pub num_tracked_points: usize,
+}
+
+#[cfg(not(any(target_os = "android", target_os = "ios")))]
+mod desktop {
+    use super::*;
+    use anyhow::Context;
+    use glam::{Affine3A, DMat4, Vec2, Vec3};
+    use sylva_tracking::depth_mesh::{DepthMesh, DepthMeshConfig, Observation};
+    use sylva_tracking::sequence::FileListSource;
+    use sylva_tracking::{FrameSource, SourceEvent, Tracker, TrackerConfig, TumSequence};
+
+    /// Plane `normal · p = offset` of the tracker as the renderer's ground (point, up normal).
+    fn ground_from_plane(normal: Vec3, offset: f32) -> GroundPlane {
+        GroundPlane {
+            point: normal * offset,
+            normal,
+        }
+    }
+
+    /// The depth mesh's pinhole camera for the footage's intrinsics.
+    fn pinhole(intrinsics: &Intrinsics) -> sylva_tracking::depth_mesh::PinholeIntrinsics {
+        sylva_tracking::depth_mesh::PinholeIntrinsics {
+            width: intrinsics.width,
+            height: intrinsics.height,
+            fx: intrinsics.fx,
+            fy: intrinsics.fy,
+            cx: intrinsics.cx,
+            cy: intrinsics.cy,
+        }
+    }
+
+    /// Tracks footage frame by frame and keeps every frame's result.
+    pub struct SceneTracker {
+        sequence: TumSequence,
+        source: FileListSource,
+        tracker: Tracker,
+        depth_mesh: DepthMesh,
+        intrinsics: Intrinsics,
+        frames: Vec<SceneFrame>,
+        num_frames: usize,
+    }
+
+    impl SceneTracker {
+        /// A tracker over the TUM-layout footage at `root` (its `camera.txt` and `rgb.txt`).
+        pub fn open(root: &Path, intrinsics: Intrinsics) -> anyhow::Result<SceneTracker> {
+            sylva_tracking::cv::configure_single_thread();
+            let sequence = TumSequence::open(root)
+                .with_context(|| format!("cannot open {} for tracking", root.display()))?;
+            let tracker = Tracker::new(sequence.camera, TrackerConfig::default())
+                .with_context(|| format!("cannot start the tracker on {}", root.display()))?;
+            let num_frames = sequence.frames.len();
+            Ok(SceneTracker {
+                source: sequence.source(),
+                sequence,
+                tracker,
+                depth_mesh: DepthMesh::new(pinhole(&intrinsics), DepthMeshConfig::default()),
+                intrinsics,
+                frames: Vec::with_capacity(num_frames),
+                num_frames,
+            })
+        }
+
+        /// The scene at footage frame `index`, tracking the frames up to it first if needed.
+        pub fn frame(&mut self, index: usize) -> anyhow::Result<&SceneFrame> {
+            let index = index.min(self.num_frames.saturating_sub(1));
+            while self.frames.len() <= index {
+                let Some(event) = self.source.next_event() else {
+                    // Fewer readable frames than listed: the rest have no pose.
+                    self.frames.push(SceneFrame::default());
+                    continue;
+                };
+                match event {
+                    SourceEvent::Frame(frame) => {
+                        let up = self.sequence.up_in_camera_at(frame.timestamp_s);
+                        let output = self
+                            .tracker
+                            .track(&frame, up.map(|u| u * 9.81))
+                            .with_context(|| format!("tracking frame {}", frame.index))?;
+                        let scene = self.scene_of(&output);
+                        self.push_at(frame.index, scene);
+                    }
+                    SourceEvent::Skipped {
+                        index,
+                        path,
+                        reason,
+                    } => {
+                        eprintln!("warning: skipped frame {}: {reason}", path.display());
+                        self.push_at(index, SceneFrame::default());
+                    }
+                }
+            }
+            Ok(&self.frames[index])
+        }
+
+        /// Stores the result for source frame `index` (frames never come out of order).
+        fn push_at(&mut self, index: usize, scene: SceneFrame) {
+            while self.frames.len() < index {
+                self.frames.push(SceneFrame::default());
+            }
+            if self.frames.len() == index {
+                self.frames.push(scene);
+            }
+        }
+
+        /// Pose, plane and depth mesh of one tracker output.
+        fn scene_of(&mut self, output: &sylva_tracking::FrameOutput) -> SceneFrame {
+            let ground = output
+                .plane
+                .map(|p| ground_from_plane(p.normal.as_vec3(), p.offset as f32));
+            let Some(world_from_camera) = output.world_from_camera else {
+                return SceneFrame {
+                    ground,
+                    ..SceneFrame::default()
+                };
+            };
+            let world_from_camera = DMat4::from(world_from_camera).as_mat4();
+            let camera_from_world = world_from_camera.inverse();
+            let k = &self.intrinsics;
+            // Observations at the ideal (undistorted) pixel of each tracked point, with its
+            // depth along the optical axis: what the pinhole depth mesh expects.
+            let observations: Vec<Observation> = output
+                .tracked_points
+                .iter()
+                .filter_map(|p| {
+                    let c = camera_from_world.transform_point3(p.world);
+                    (c.z > 1e-3 && c.is_finite()).then(|| Observation {
+                        id: p.id,
+                        pixel: Vec2::new(k.fx * c.x / c.z + k.cx, k.fy * c.y / c.z + k.cy),
+                        depth_m: c.z,
+                    })
+                })
+                .collect();
+            self.depth_mesh.update(&observations);
+            let mesh = self
+                .depth_mesh
+                .export_camera_space()
+                .to_world(&Affine3A::from_mat4(world_from_camera));
+            SceneFrame {
+                world_from_camera: Some(world_from_camera),
+                ground,
+                occluder: OccluderMesh {
+                    positions: mesh.positions,
+                    indices: mesh.indices,
+                },
+                num_tracked_points: observations.len(),
+            }
+        }
+    }
+}
+
+#[cfg(not(any(target_os = "android", target_os = "ios")))]
+pub use desktop::SceneTracker;
+
+/// Phone builds leave the OpenCV tracker out: their poses come from the platform's AR session.
+#[cfg(any(target_os = "android", target_os = "ios"))]
+pub struct SceneTracker {
+    frames: Vec<SceneFrame>,
+}
+
+#[cfg(any(target_os = "android", target_os = "ios"))]
+impl SceneTracker {
+    pub fn open(root: &Path, _intrinsics: Intrinsics) -> anyhow::Result<SceneTracker> {
+        anyhow::bail!(
+            "tracking recorded footage ({}) needs the OpenCV tracker, which phone builds leave out",
+            root.display()
+        )
+    }
+
+    pub fn frame(&mut self, index: usize) -> anyhow::Result<&SceneFrame> {
+        self.frames
+            .get(index)
+            .ok_or_else(|| anyhow::anyhow!("no tracked frame {index}"))
+    }
+}
