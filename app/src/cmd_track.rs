@@ -2,6 +2,7 @@
 //! tracker over a recorded TUM-layout sequence, prints per-stage timings and ends with one
 //! `key=value` line (error fields only when the sequence has ground truth).
 
+#[cfg(not(any(target_os = "android", target_os = "ios")))]
 use anyhow::Context;
 use std::path::PathBuf;
 
