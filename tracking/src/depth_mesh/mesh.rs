@@ -6,7 +6,10 @@
 //! the changed points and their neighbours only, and the surface follows those verdicts. The
 //! scratch buffers live in the mesh, so a steady-state update does not allocate.
 
+use std::sync::atomic::AtomicUsize;
+
 use glam::Vec2;
+use spade::handles::FixedVertexHandle;
 use spade::{HasPosition, Point2, Triangulation};
 
 use super::consistency::{CHANGED, IN_SURFACE, LENIENT, SEEN, Scratch, Support};
@@ -52,6 +55,8 @@ pub(crate) struct Work {
     /// Vertices whose consistency must be re-evaluated (`dirty_set` deduplicates).
     pub(crate) dirty: Vec<u64>,
     dirty_set: IdSet,
+    /// The dirty vertices with their image-order keys.
+    ordered: Vec<(u32, FixedVertexHandle)>,
     /// Lenient verdicts (any neighbours vouch) of the changed points.
     pub(crate) lenient: Vec<(u64, bool)>,
     pub(crate) verdicts: Vec<(MeshVertex, bool)>,
@@ -66,6 +71,7 @@ impl Work {
         self.changed.clear();
         self.dirty.clear();
         self.dirty_set.clear();
+        self.ordered.clear();
         self.lenient.clear();
         self.verdicts.clear();
         self.reinsert.clear();
@@ -85,6 +91,9 @@ pub struct DepthMesh {
     pub(crate) all: Layer,
     pub(crate) surface: Layer,
     work: Work,
+    /// A corner of the face the last query found (index of a surface vertex; a stale one is
+    /// only a worse start), where the next query's walk starts when it is near.
+    pub(crate) last_query_vertex: AtomicUsize,
 }
 
 impl DepthMesh {
@@ -95,6 +104,7 @@ impl DepthMesh {
             all: Layer::new(&camera),
             surface: Layer::new(&camera),
             work: Work::default(),
+            last_query_vertex: AtomicUsize::new(usize::MAX),
         }
     }
 
@@ -196,7 +206,9 @@ impl DepthMesh {
         }
         stats.num_removed = lost.len();
         work.lost = lost;
-        let pending = std::mem::take(&mut work.pending);
+        let mut pending = std::mem::take(&mut work.pending);
+        // Edits in image order stay near the previous edit's (cached) neighbourhood.
+        pending.sort_unstable_by_key(|&index| image_order(observations[index].pixel));
         for &index in &pending {
             match self.insert_or_move(observations[index], &mut work) {
                 Ok(Change::Inserted) => stats.num_inserted += 1,
@@ -298,6 +310,7 @@ impl DepthMesh {
             lenient,
             verdicts,
             scratch,
+            ordered,
             ..
         } = work;
         for &id in changed.iter() {
@@ -309,11 +322,18 @@ impl DepthMesh {
             self.all.set_mark(id, CHANGED, true);
             self.all.set_mark(id, LENIENT, verdict);
         }
-        for &id in dirty.iter() {
-            if let Some(&handle) = self.all.handles.get(&id) {
-                let consistent = self.is_supported(handle, Support::Strict, scratch);
-                verdicts.push((*self.all.triangles.vertex(handle).data(), consistent));
-            }
+        // In image order, so consecutive tests share most of their neighbourhoods (and the
+        // surface edits that follow stay local too): far fewer cache misses on large meshes.
+        ordered.clear();
+        ordered.extend(dirty.iter().filter_map(|id| {
+            let handle = *self.all.handles.get(id)?;
+            let pixel = self.all.triangles.vertex(handle).data().pixel;
+            Some((image_order(pixel), handle))
+        }));
+        ordered.sort_unstable_by_key(|&(key, _)| key);
+        for &(_, handle) in ordered.iter() {
+            let consistent = self.is_supported(handle, Support::Strict, scratch);
+            verdicts.push((*self.all.triangles.vertex(handle).data(), consistent));
         }
         for &(id, _) in lenient.iter() {
             self.all.set_mark(id, CHANGED | LENIENT, false);
@@ -387,6 +407,12 @@ impl DepthMesh {
             assert_eq!(surface, all, "surface point {id} differs from all points");
         }
     }
+}
+
+/// Sort key of a pixel: 16-pixel bands top to bottom, left to right within a band.
+fn image_order(pixel: Vec2) -> u32 {
+    let band = (pixel.y / 16.0).max(0.0) as u32;
+    band * 4096 + (pixel.x.max(0.0) as u32).min(4095)
 }
 
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

@@ -1,7 +1,9 @@
 //! Queries: depth at a pixel (barycentric in inverse depth) and occlusion of world points.
 
 use glam::{Affine3A, Vec2, Vec3};
-use spade::handles::{FixedFaceHandle, InnerTag};
+use std::sync::atomic::Ordering;
+
+use spade::handles::{FixedFaceHandle, FixedVertexHandle, InnerTag};
 use spade::{PositionInTriangulation, Triangulation};
 
 use super::mesh::MeshVertex;
@@ -10,6 +12,9 @@ use super::{DepthMesh, PinholeIntrinsics};
 /// Most faces a query walk crosses before handing over to spade's point location (a walk
 /// from the hint grid usually crosses a few).
 const MAX_WALK_STEPS: usize = 256;
+
+/// A query walk starts from the last face found when that is this close (pixels).
+const LAST_FACE_REACH_PX: f32 = 12.0;
 
 /// Outcome of a query walk.
 enum Walk {
@@ -110,7 +115,7 @@ impl DepthMesh {
         if triangles.num_inner_faces() == 0 {
             return Walk::OutsideHull;
         }
-        let Some(start) = self.surface.hint(pixel) else {
+        let Some(start) = self.walk_start(pixel) else {
             return Walk::GaveUp;
         };
         let Some(mut face) = triangles
@@ -127,6 +132,8 @@ impl DepthMesh {
                 (b.x - a.x) * (py - a.y) - (b.y - a.y) * (px - a.x) < 0.0
             });
             let Some(exit) = exit else {
+                let corner = face.vertices()[0].fix().index();
+                self.last_query_vertex.store(corner, Ordering::Relaxed);
                 return Walk::Found(face.fix());
             };
             match exit.rev().face().as_inner() {
@@ -135,6 +142,20 @@ impl DepthMesh {
             }
         }
         Walk::GaveUp
+    }
+
+    /// Where a query walk starts: a corner of the last face found when it is near `pixel`
+    /// (queries in scan order), else the hint grid's vertex.
+    fn walk_start(&self, pixel: Vec2) -> Option<FixedVertexHandle> {
+        let last = self.last_query_vertex.load(Ordering::Relaxed);
+        if last < self.surface.triangles.num_vertices() {
+            let handle = FixedVertexHandle::from_index(last);
+            let corner = self.surface.triangles.vertex(handle).data().pixel;
+            if corner.distance_squared(pixel) <= LAST_FACE_REACH_PX * LAST_FACE_REACH_PX {
+                return Some(handle);
+            }
+        }
+        self.surface.hint(pixel)
     }
 
     /// Spade's exact point location (the fallback of [`Self::walk_to_face`]).
