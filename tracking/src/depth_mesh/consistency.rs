@@ -22,6 +22,8 @@ pub(crate) const CHANGED: u8 = 2;
 pub(crate) const LENIENT: u8 = 4;
 /// Flag: observed in the current frame (set and cleared within an update).
 pub(crate) const SEEN: u8 = 8;
+/// Flag: in the work list of vertices to re-evaluate (set and cleared within an edit).
+pub(crate) const DIRTY: u8 = 16;
 
 /// How a consistency test counts support.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]

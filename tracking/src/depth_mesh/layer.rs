@@ -286,6 +286,36 @@ impl Layer {
         self.marks[handle.index()]
     }
 
+    /// Sets the flags `bits` on the vertex of `id` (if `include_self`) and on its neighbours;
+    /// appends the ids of those that lacked them to `ids` (a deduplicating work list).
+    pub(crate) fn flag_around(
+        &mut self,
+        id: u64,
+        bits: u8,
+        include_self: bool,
+        ids: &mut Vec<u64>,
+    ) {
+        let Some(&handle) = self.handles.get(&id) else {
+            return;
+        };
+        if include_self && self.marks[handle.index()] & bits == 0 {
+            self.marks[handle.index()] |= bits;
+            ids.push(id);
+        }
+        for edge in self.triangles.vertex(handle).out_edges() {
+            let mark = &mut self.marks[edge.to().fix().index()];
+            if *mark & bits == 0 {
+                *mark |= bits;
+                ids.push(edge.to().data().id);
+            }
+        }
+    }
+
+    /// Clears the flags `bits` of a vertex.
+    pub(crate) fn clear_mark(&mut self, handle: FixedVertexHandle, bits: u8) {
+        self.marks[handle.index()] &= !bits;
+    }
+
     /// Sets the flags `bits` of the vertex of `id` and returns the vertex, if held.
     pub(crate) fn mark_seen(&mut self, id: u64, bits: u8) -> Option<MeshVertex> {
         let handle = *self.handles.get(&id)?;
@@ -358,16 +388,6 @@ impl Layer {
             .vertex(handle)
             .out_edges()
             .map(|edge| (edge.to().fix(), *edge.to().data()))
-    }
-
-    /// The vertices around `id` (its 1-ring, in angular order).
-    pub(crate) fn neighbours(&self, id: u64) -> impl Iterator<Item = MeshVertex> + '_ {
-        self.handles.get(&id).into_iter().flat_map(move |&handle| {
-            self.triangles
-                .vertex(handle)
-                .out_edges()
-                .map(|edge| *edge.to().data())
-        })
     }
 }
 

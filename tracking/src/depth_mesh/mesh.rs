@@ -12,8 +12,8 @@ use glam::Vec2;
 use spade::handles::FixedVertexHandle;
 use spade::{HasPosition, Point2, Triangulation};
 
-use super::consistency::{CHANGED, IN_SURFACE, LENIENT, SEEN, Scratch, Support};
-use super::layer::{IdSet, Layer};
+use super::consistency::{CHANGED, DIRTY, IN_SURFACE, LENIENT, SEEN, Scratch, Support};
+use super::layer::Layer;
 use super::{DepthMeshConfig, DepthMeshError, Observation, PinholeIntrinsics};
 
 /// A vertex: pixel position, depth and the map point it came from.
@@ -52,9 +52,8 @@ pub(crate) struct Work {
     pending: Vec<usize>,
     /// Points inserted, moved or given a new depth: they have no standing in the surface yet.
     pub(crate) changed: Vec<u64>,
-    /// Vertices whose consistency must be re-evaluated (`dirty_set` deduplicates).
+    /// Vertices whose consistency must be re-evaluated (their `DIRTY` flag deduplicates).
     pub(crate) dirty: Vec<u64>,
-    dirty_set: IdSet,
     /// The dirty vertices with their image-order keys.
     ordered: Vec<(u32, FixedVertexHandle)>,
     /// Lenient verdicts (any neighbours vouch) of the changed points.
@@ -70,17 +69,10 @@ impl Work {
         self.pending.clear();
         self.changed.clear();
         self.dirty.clear();
-        self.dirty_set.clear();
         self.ordered.clear();
         self.lenient.clear();
         self.verdicts.clear();
         self.reinsert.clear();
-    }
-
-    fn mark_dirty(&mut self, id: u64) {
-        if self.dirty_set.insert(id) {
-            self.dirty.push(id);
-        }
     }
 }
 
@@ -238,20 +230,15 @@ impl DepthMesh {
     }
 
     /// Marks `id` and its current neighbours for re-evaluation.
-    fn mark_with_neighbours(&self, id: u64, work: &mut Work) {
-        work.mark_dirty(id);
-        for n in self.all.neighbours(id) {
-            work.mark_dirty(n.id);
-        }
+    fn mark_with_neighbours(&mut self, id: u64, work: &mut Work) {
+        self.all.flag_around(id, DIRTY, true, &mut work.dirty);
     }
 
     fn remove_into(&mut self, id: u64, work: &mut Work) -> bool {
         if !self.all.handles.contains_key(&id) {
             return false;
         }
-        for n in self.all.neighbours(id) {
-            work.mark_dirty(n.id);
-        }
+        self.all.flag_around(id, DIRTY, false, &mut work.dirty);
         self.all.remove(id);
         self.surface.remove(id);
         true
@@ -282,9 +269,8 @@ impl DepthMesh {
         let moved = old.pixel.distance(vertex.pixel) > self.config.move_tolerance_px;
         if moved {
             // Neighbours before the move lose or change a neighbour too.
-            for n in self.all.neighbours(vertex.id) {
-                work.mark_dirty(n.id);
-            }
+            self.all
+                .flag_around(vertex.id, DIRTY, false, &mut work.dirty);
             self.all.move_vertex(vertex)?;
         } else {
             // Same place, new depth: no re-triangulation in either layer.
@@ -331,6 +317,9 @@ impl DepthMesh {
             Some((image_order(pixel), handle))
         }));
         ordered.sort_unstable_by_key(|&(key, _)| key);
+        for &(_, handle) in ordered.iter() {
+            self.all.clear_mark(handle, DIRTY);
+        }
         for &(_, handle) in ordered.iter() {
             let consistent = self.is_supported(handle, Support::Strict, scratch);
             verdicts.push((*self.all.triangles.vertex(handle).data(), consistent));
@@ -395,6 +384,11 @@ impl DepthMesh {
             super::validity::check_triangulation(&layer.triangles);
         }
         for (&id, &handle) in &self.all.handles {
+            assert_eq!(
+                self.all.mark(handle) & !IN_SURFACE,
+                0,
+                "stray flags on point {id}"
+            );
             assert_eq!(
                 self.all.mark(handle) & IN_SURFACE != 0,
                 self.surface.handles.contains_key(&id),
