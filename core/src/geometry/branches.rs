@@ -48,6 +48,8 @@ struct ChainRings {
 #[derive(Default)]
 struct SideTables {
     max_sides: u32,
+    /// Mid-radius of a polygonal contour of C sides relative to its circumradius, per C.
+    shrink: Vec<f32>,
     offsets: Vec<usize>,
     cos_sin: Vec<(f32, f32)>,
     pattern_offsets: Vec<usize>,
@@ -75,10 +77,18 @@ impl SideTables {
         }
         SideTables {
             max_sides,
+            shrink: (0..=max_sides).map(contour_shrink).collect(),
             offsets,
             cos_sin,
             pattern_offsets,
             patterns,
+        }
+    }
+
+    fn shrink(&self, sides: u32) -> f32 {
+        match self.shrink.get(sides as usize) {
+            Some(&shrink) => shrink,
+            None => contour_shrink(sides),
         }
     }
 
@@ -107,9 +117,21 @@ pub(crate) struct RingFrames {
     chain_geometry: Vec<NodeGeom>,
 }
 
+/// Mid-radius of the polygonal contour of a parent with `sides` sides, relative to its
+/// circumradius (at least 0.96): a child's first ring laid at this radius shows no gap.
+fn contour_shrink(sides: u32) -> f32 {
+    (0.5 * (1.0 + (PI / sides as f32).cos())).max(0.96)
+}
+
 /// Sides C = 3·dⁿ/d_e (eq. C.2) of a branch of base diameter `d`, clamped to [3, max].
 fn contour_sides(diameter: f32, thinnest: f32, exponent: f32, max_sides: u32) -> u32 {
-    let sides = 3.0 * diameter.powf(exponent) / thinnest;
+    // pow(d, 1) = d exactly: the common exponent skips the costly `powf`.
+    let power = if exponent == 1.0 {
+        diameter
+    } else {
+        diameter.powf(exponent)
+    };
+    let sides = 3.0 * power / thinnest;
     (sides.round() as u32).clamp(3, max_sides.max(3))
 }
 
@@ -407,7 +429,7 @@ impl RingFrames {
         parent_sides: Option<u32>,
     ) {
         // Mid-radius of the parent's polygonal contour, so the joint shows no gap.
-        let shrink = parent_sides.map(|c| (0.5 * (1.0 + (PI / c as f32).cos())).max(0.96));
+        let shrink = parent_sides.map(|c| self.tables.shrink(c));
         let table = self.tables.get(sides);
         let pattern = self.tables.index_pattern(sides);
         let rings =

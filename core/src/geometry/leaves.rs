@@ -230,9 +230,14 @@ pub fn build_fruit_into(
             continue;
         }
         let light = node.light_exposure.clamp(0.0, 1.0);
+        // r < 1, so no bud of a node this dim wins: skip it without reading its buds.
+        if light * light <= params.threshold {
+            continue;
+        }
         let buds = node.terminal_bud.iter().chain(node.lateral_buds.iter());
-        let node_hash = position_hash(node.end);
+        let mut node_hash = None;
         for (k, bud) in buds.enumerate().filter(|(_, b)| b.alive) {
+            let node_hash = *node_hash.get_or_insert_with(|| position_hash(node.end));
             let r = hash_unit(node_hash ^ ((k as u64) << 48) ^ index as u64);
             if r * light * light <= params.threshold {
                 continue;
@@ -298,9 +303,10 @@ fn push_icosahedron(mesh: &mut TreeMesh, center: Vec3, radius: f32, light: f32) 
         [8, 6, 7],
         [9, 8, 1],
     ];
+    static NORMALS: std::sync::OnceLock<[Vec3; 12]> = std::sync::OnceLock::new();
+    let normals = NORMALS.get_or_init(|| CORNERS.map(|corner| Vec3::from(corner).normalize()));
     let base = mesh.positions.len() as u32;
-    for corner in CORNERS {
-        let normal = Vec3::from(corner).normalize();
+    for &normal in normals {
         let uv = [0.5 + 0.5 * normal.x, 0.5 - 0.5 * normal.y];
         mesh.push_vertex(center + normal * radius, normal, uv, light);
     }

@@ -37,6 +37,7 @@ impl Levels {
 #[derive(Default)]
 pub struct Mesher {
     nodes: Vec<NodeGeom>,
+    diameters: Vec<f32>,
     topology: BranchTopology,
     frames: RingFrames,
     leaf_scratch: LeafScratch,
@@ -59,7 +60,11 @@ impl Mesher {
         meshes: &mut TreeMeshes,
     ) {
         NodeGeom::collect_into(skeleton, &mut self.nodes);
-        self.topology.build_into(skeleton);
+        self.diameters.clear();
+        self.diameters
+            .extend(self.nodes.iter().map(|node| node.diameter));
+        self.topology
+            .build_with_diameters(skeleton, &self.diameters);
         self.frames
             .build_into(&self.nodes, &self.topology, params, ambient);
         leaves::build_leaves_into(

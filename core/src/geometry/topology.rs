@@ -44,13 +44,20 @@ impl BranchTopology {
 
     /// [`BranchTopology::build`] into `self`, reusing its buffers.
     pub fn build_into(&mut self, skeleton: &Skeleton) {
+        let diameters: Vec<f32> = skeleton.internodes.iter().map(|n| n.diameter).collect();
+        self.build_with_diameters(skeleton, &diameters);
+    }
+
+    /// [`BranchTopology::build_into`] with the internode diameters given in arena order: a
+    /// compact array that stays in cache while the children are looked up.
+    pub(crate) fn build_with_diameters(&mut self, skeleton: &Skeleton, diameters: &[f32]) {
         let nodes = &skeleton.internodes;
         self.visual_child.clear();
         self.visual_child.extend(nodes.iter().map(|node| {
             let mut best = NONE;
             let mut best_diameter = f32::NEG_INFINITY;
             for child in node.children() {
-                let diameter = nodes[child.index()].diameter;
+                let diameter = diameters[child.index()];
                 if diameter > best_diameter {
                     best = child.0;
                     best_diameter = diameter;
