@@ -9,7 +9,8 @@
 
 use std::path::Path;
 
-use glam::Mat4;
+use glam::{Affine3A, Mat4};
+use sylva_tracking::depth_mesh::{DepthMesh, DepthMeshConfig, Observation, PinholeIntrinsics};
 
 use crate::render::{GroundPlane, Intrinsics, OccluderMesh};
 
@@ -20,18 +21,57 @@ pub struct SceneFrame {
     pub world_from_camera: Option<Mat4>,
     /// The ground plane once found.
     pub ground: Option<GroundPlane>,
+    /// The map points tracked in this frame: id, ideal (undistorted) pixel and depth along the
+    /// optical axis. Sessions record them; the depth mesh is built from them.
+    pub observations: Vec<Observation>,
     /// The depth mesh of the tracked points in the world (empty without a pose).
     pub occluder: OccluderMesh,
-    /// Map points tracked in this frame.
-    pub num_tracked_points: usize,
+}
+
+/// The incremental depth mesh of the tracked points, turned into the renderer's occluder. Live
+/// tracking and session replays feed it the same observations, so they draw the same occluder.
+pub struct SceneMesher {
+    depth_mesh: DepthMesh,
+}
+
+impl SceneMesher {
+    pub fn new(intrinsics: &Intrinsics) -> SceneMesher {
+        let camera = PinholeIntrinsics {
+            width: intrinsics.width,
+            height: intrinsics.height,
+            fx: intrinsics.fx,
+            fy: intrinsics.fy,
+            cx: intrinsics.cx,
+            cy: intrinsics.cy,
+        };
+        SceneMesher {
+            depth_mesh: DepthMesh::new(camera, DepthMeshConfig::default()),
+        }
+    }
+
+    /// Updates the mesh with one frame's observations and returns it in the world.
+    pub fn update(
+        &mut self,
+        observations: &[Observation],
+        world_from_camera: Mat4,
+    ) -> OccluderMesh {
+        self.depth_mesh.update(observations);
+        let mesh = self
+            .depth_mesh
+            .export_camera_space()
+            .to_world(&Affine3A::from_mat4(world_from_camera));
+        OccluderMesh {
+            positions: mesh.positions,
+            indices: mesh.indices,
+        }
+    }
 }
 
 #[cfg(not(any(target_os = "android", target_os = "ios")))]
 mod desktop {
     use super::*;
     use anyhow::Context;
-    use glam::{Affine3A, DMat4, Vec2, Vec3};
-    use sylva_tracking::depth_mesh::{DepthMesh, DepthMeshConfig, Observation};
+    use glam::{DMat4, Vec2, Vec3};
     use sylva_tracking::sequence::FileListSource;
     use sylva_tracking::{FrameSource, SourceEvent, Tracker, TrackerConfig, TumSequence};
 
@@ -43,24 +83,12 @@ mod desktop {
         }
     }
 
-    /// The depth mesh's pinhole camera for the footage's intrinsics.
-    fn pinhole(intrinsics: &Intrinsics) -> sylva_tracking::depth_mesh::PinholeIntrinsics {
-        sylva_tracking::depth_mesh::PinholeIntrinsics {
-            width: intrinsics.width,
-            height: intrinsics.height,
-            fx: intrinsics.fx,
-            fy: intrinsics.fy,
-            cx: intrinsics.cx,
-            cy: intrinsics.cy,
-        }
-    }
-
     /// Tracks footage frame by frame and keeps every frame's result.
     pub struct SceneTracker {
         sequence: TumSequence,
         source: FileListSource,
         tracker: Tracker,
-        depth_mesh: DepthMesh,
+        mesher: SceneMesher,
         intrinsics: Intrinsics,
         frames: Vec<SceneFrame>,
         num_frames: usize,
@@ -79,7 +107,7 @@ mod desktop {
                 source: sequence.source(),
                 sequence,
                 tracker,
-                depth_mesh: DepthMesh::new(pinhole(&intrinsics), DepthMeshConfig::default()),
+                mesher: SceneMesher::new(&intrinsics),
                 intrinsics,
                 frames: Vec::with_capacity(num_frames),
                 num_frames,
@@ -149,26 +177,25 @@ mod desktop {
                 .iter()
                 .filter_map(|p| {
                     let c = camera_from_world.transform_point3(p.world);
+                    // Rounded to 0.01 px and 1 mm (far below tracking noise) so sessions
+                    // record them compactly and replays mesh exactly what the app meshed.
+                    let round = |x: f32, step: f32| (x / step).round() * step;
                     (c.z > 1e-3 && c.is_finite()).then(|| Observation {
                         id: p.id,
-                        pixel: Vec2::new(k.fx * c.x / c.z + k.cx, k.fy * c.y / c.z + k.cy),
-                        depth_m: c.z,
+                        pixel: Vec2::new(
+                            round(k.fx * c.x / c.z + k.cx, 0.01),
+                            round(k.fy * c.y / c.z + k.cy, 0.01),
+                        ),
+                        depth_m: round(c.z, 0.001),
                     })
                 })
                 .collect();
-            self.depth_mesh.update(&observations);
-            let mesh = self
-                .depth_mesh
-                .export_camera_space()
-                .to_world(&Affine3A::from_mat4(world_from_camera));
+            let occluder = self.mesher.update(&observations, world_from_camera);
             SceneFrame {
                 world_from_camera: Some(world_from_camera),
                 ground,
-                occluder: OccluderMesh {
-                    positions: mesh.positions,
-                    indices: mesh.indices,
-                },
-                num_tracked_points: observations.len(),
+                observations,
+                occluder,
             }
         }
     }

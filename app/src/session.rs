@@ -12,11 +12,13 @@ use serde::{Deserialize, Serialize};
 use crate::footage::Footage;
 use crate::render::offscreen::OFFSCREEN_FORMAT;
 use crate::render::{FrameView, Gpu, GroundPlane, Offscreen, Renderer, ViewCamera};
-use crate::scene_tracking::{SceneFrame, SceneTracker};
+use crate::scene_tracking::{SceneFrame, SceneMesher};
 use crate::state::{DesignState, InputEvent, Parameters};
+use sylva_tracking::depth_mesh::Observation;
 
 pub const SESSION_FORMAT: &str = "sylva-session";
-pub const SESSION_VERSION: u32 = 1;
+/// 2: frames record their tracked points (v1 sessions, made with ground-truth poses, are refused).
+pub const SESSION_VERSION: u32 = 2;
 
 /// Tracking output for one frame.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -27,6 +29,26 @@ pub struct FrameRecord {
     pub world_from_camera: Option<[f32; 16]>,
     /// Ground plane (point, normal) once found.
     pub ground: Option<[f32; 6]>,
+    /// Tracked points: map-point id, ideal pixel (x, y) and depth along the optical axis (m).
+    pub points: Vec<PointRecord>,
+}
+
+/// One tracked point of a frame, written as `[id, x, y, depth_m]`.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+pub struct PointRecord(pub u64, pub f32, pub f32, pub f32);
+
+impl FrameRecord {
+    /// The recorded tracked points as depth-mesh observations.
+    pub fn observations(&self) -> Vec<Observation> {
+        self.points
+            .iter()
+            .map(|p| Observation {
+                id: p.0,
+                pixel: glam::Vec2::new(p.1, p.2),
+                depth_m: p.3,
+            })
+            .collect()
+    }
 }
 
 /// An input event and when it happened.
@@ -81,6 +103,11 @@ impl Session {
                     g.point.x, g.point.y, g.point.z, g.normal.x, g.normal.y, g.normal.z,
                 ]
             }),
+            points: scene
+                .observations
+                .iter()
+                .map(|o| PointRecord(o.id, o.pixel.x, o.pixel.y, o.depth_m))
+                .collect(),
         });
     }
 
@@ -112,7 +139,9 @@ impl Session {
     }
 
     pub fn save(&self, path: &Path) -> anyhow::Result<()> {
-        let json = serde_json::to_string_pretty(self)?;
+        // Compact: a few hundred tracked points per frame make pretty-printing several times
+        // larger.
+        let json = serde_json::to_string(self)?;
         std::fs::write(path, json).with_context(|| format!("cannot write {}", path.display()))
     }
 }
@@ -167,12 +196,9 @@ pub fn replay(
     } else {
         None
     };
-    // Poses and the ground come from the recording; the occluding depth mesh is rebuilt by
-    // tracking the footage again (the tracker is deterministic).
-    let mut tracker = match render {
-        true => Some(SceneTracker::open(&footage.root, footage.intrinsics)?),
-        false => None,
-    };
+    // Everything comes from the recording (poses, ground, tracked points): a replay needs no
+    // tracker and gives the same frames on every machine.
+    let mut mesher = SceneMesher::new(&footage.intrinsics);
     let mut state = DesignState::new(session.seed, session.parameters.clone());
     let mut meshed_revision = None;
     let mut frame_sha256 = Vec::new();
@@ -210,9 +236,8 @@ pub fn replay(
         }
         let rgba = footage.load_rgba(index)?;
         renderer.set_camera_image(gpu, rgba.as_raw(), footage.intrinsics);
-        if let Some(tracker) = tracker.as_mut() {
-            renderer.set_occluder(gpu, &tracker.frame(index)?.occluder);
-        }
+        let occluder = mesher.update(&record.observations(), camera.world_from_camera);
+        renderer.set_occluder(gpu, &occluder);
         let ground = record.ground.map(|g| GroundPlane {
             point: glam::Vec3::new(g[0], g[1], g[2]),
             normal: glam::Vec3::new(g[3], g[4], g[5]),
