@@ -9,7 +9,7 @@
 //! turns into SIMD), with exactly the arithmetic of the one-leaf path, so both give the same
 //! bits.
 
-use glam::Vec3;
+use glam::{Vec3, Vec4};
 
 use super::LeafParams;
 use super::any_perpendicular;
@@ -138,38 +138,44 @@ impl Petiole {
         let heading = V4::gather(at, |a| a.heading);
         let radial = V4::gather(at, |a| a.radial);
         let mut h = heading
-            .scale1(self.cos_insertion)
-            .add(radial.scale1(self.sin_insertion));
+            .scale(Vec4::splat(self.cos_insertion))
+            .add(radial.scale(Vec4::splat(self.sin_insertion)));
         let mut l = heading.cross(radial).try_normalize()?;
         let target = V4::splat(self.target);
-        let ds = self.step_length;
-        let half = lanes(|i| 0.5 * at[i].light * ds);
+        let ds = Vec4::splat(self.step_length);
+        let light = Vec4::new(at[0].light, at[1].light, at[2].light, at[3].light);
+        let half = Vec4::splat(0.5) * light * ds;
+        let (twist, bend, turn) = (
+            Vec4::splat(-self.twist_rate),
+            Vec4::splat(self.bend_rate),
+            Vec4::splat(self.turn_rate),
+        );
+        let one = Vec4::ONE;
         let mut position = V4::gather(at, |a| a.point);
         for _ in 0..self.steps {
             let u = h.cross(l);
             let (h_t, l_t, l_h) = (h.dot(target), l.dot(target), l.dot(h));
-            let mut frame = [[[0.0; 3]; 2]; 4];
-            for (i, lane) in frame.iter_mut().enumerate() {
-                let (new_h, new_l) =
-                    rotated_frame(rotation_components(self, h_t[i], l_t[i], l_h[i], half[i]));
-                *lane = [new_h, new_l];
-            }
-            let coefficient = |axis: usize, k: usize| lanes(|i| frame[i][axis][k]);
+            // rotation_components and rotated_frame in four lanes.
+            let a = twist * l_t * half;
+            let b = bend * h_t * half;
+            let c = turn * (l_h - l_t * h_t) * half;
+            let (aa, bb, cc) = (a * a, b * b, c * c);
+            let s = Vec4::splat(2.0) / (one + aa + bb + cc);
             let next_h = h
-                .scale(coefficient(0, 0))
-                .add(l.scale(coefficient(0, 1)))
-                .add(u.scale(coefficient(0, 2)));
+                .scale(one - s * (bb + cc))
+                .add(l.scale(s * (c + a * b)))
+                .add(u.scale(s * (a * c - b)));
             l = h
-                .scale(coefficient(1, 0))
-                .add(l.scale(coefficient(1, 1)))
-                .add(u.scale(coefficient(1, 2)));
+                .scale(s * (a * b - c))
+                .add(l.scale(one - s * (aa + cc)))
+                .add(u.scale(s * (a + b * c)));
             h = next_h;
-            position = position.add(h.scale1(ds));
+            position = position.add(h.scale(ds));
         }
         let h = h.try_normalize()?;
         let l = l.sub(h.scale(l.dot(h))).try_normalize()?;
-        let half_width = l.scale1(self.half_width);
-        let tip = position.add(h.scale1(self.blade_length));
+        let half_width = l.scale(Vec4::splat(self.half_width));
+        let tip = position.add(h.scale(Vec4::splat(self.blade_length)));
         let corners = [
             position.sub(half_width),
             position.add(half_width),
@@ -177,46 +183,45 @@ impl Petiole {
             tip.add(half_width),
         ];
         let normal = h.cross(l);
-        Some(std::array::from_fn(|i| Blade {
-            corners: corners.map(|c| c.lane(i)),
+        let blade = |i: usize| Blade {
+            corners: [
+                corners[0].lane(i),
+                corners[1].lane(i),
+                corners[2].lane(i),
+                corners[3].lane(i),
+            ],
             normal: normal.lane(i),
-        }))
+        };
+        Some([blade(0), blade(1), blade(2), blade(3)])
     }
 }
 
-type Lanes = [f32; 4];
-
-#[inline(always)]
-fn lanes(f: impl Fn(usize) -> f32) -> Lanes {
-    std::array::from_fn(f)
-}
-
-/// Four vectors, one per lane, stored by component.
+/// Four vectors, one per lane of glam's `Vec4` (SIMD on x86-64), stored by component. The
+/// operations repeat glam's `Vec3` arithmetic operation for operation, lane by lane.
 #[derive(Clone, Copy)]
 struct V4 {
-    x: Lanes,
-    y: Lanes,
-    z: Lanes,
+    x: Vec4,
+    y: Vec4,
+    z: Vec4,
 }
 
-/// The operations below repeat glam's `Vec3` arithmetic operation for operation, lane by lane.
 impl V4 {
     #[inline(always)]
     fn gather(at: &[Attachment; 4], f: impl Fn(&Attachment) -> Vec3) -> V4 {
-        let v: [Vec3; 4] = std::array::from_fn(|i| f(&at[i]));
+        let v = [f(&at[0]), f(&at[1]), f(&at[2]), f(&at[3])];
         V4 {
-            x: lanes(|i| v[i].x),
-            y: lanes(|i| v[i].y),
-            z: lanes(|i| v[i].z),
+            x: Vec4::new(v[0].x, v[1].x, v[2].x, v[3].x),
+            y: Vec4::new(v[0].y, v[1].y, v[2].y, v[3].y),
+            z: Vec4::new(v[0].z, v[1].z, v[2].z, v[3].z),
         }
     }
 
     #[inline(always)]
     fn splat(v: Vec3) -> V4 {
         V4 {
-            x: [v.x; 4],
-            y: [v.y; 4],
-            z: [v.z; 4],
+            x: Vec4::splat(v.x),
+            y: Vec4::splat(v.y),
+            z: Vec4::splat(v.z),
         }
     }
 
@@ -228,58 +233,56 @@ impl V4 {
     #[inline(always)]
     fn add(self, o: V4) -> V4 {
         V4 {
-            x: lanes(|i| self.x[i] + o.x[i]),
-            y: lanes(|i| self.y[i] + o.y[i]),
-            z: lanes(|i| self.z[i] + o.z[i]),
+            x: self.x + o.x,
+            y: self.y + o.y,
+            z: self.z + o.z,
         }
     }
 
     #[inline(always)]
     fn sub(self, o: V4) -> V4 {
         V4 {
-            x: lanes(|i| self.x[i] - o.x[i]),
-            y: lanes(|i| self.y[i] - o.y[i]),
-            z: lanes(|i| self.z[i] - o.z[i]),
+            x: self.x - o.x,
+            y: self.y - o.y,
+            z: self.z - o.z,
         }
     }
 
     #[inline(always)]
-    fn scale(self, s: Lanes) -> V4 {
+    fn scale(self, s: Vec4) -> V4 {
         V4 {
-            x: lanes(|i| self.x[i] * s[i]),
-            y: lanes(|i| self.y[i] * s[i]),
-            z: lanes(|i| self.z[i] * s[i]),
+            x: self.x * s,
+            y: self.y * s,
+            z: self.z * s,
         }
     }
 
     #[inline(always)]
-    fn scale1(self, s: f32) -> V4 {
-        self.scale([s; 4])
-    }
-
-    #[inline(always)]
-    fn dot(self, o: V4) -> Lanes {
-        lanes(|i| (self.x[i] * o.x[i]) + (self.y[i] * o.y[i]) + (self.z[i] * o.z[i]))
+    fn dot(self, o: V4) -> Vec4 {
+        (self.x * o.x) + (self.y * o.y) + (self.z * o.z)
     }
 
     #[inline(always)]
     fn cross(self, o: V4) -> V4 {
         V4 {
-            x: lanes(|i| self.y[i] * o.z[i] - o.y[i] * self.z[i]),
-            y: lanes(|i| self.z[i] * o.x[i] - o.z[i] * self.x[i]),
-            z: lanes(|i| self.x[i] * o.y[i] - o.x[i] * self.y[i]),
+            x: self.y * o.z - o.y * self.z,
+            y: self.z * o.x - o.z * self.x,
+            z: self.x * o.y - o.x * self.y,
         }
     }
 
     /// glam's `try_normalize` in every lane; `None` when it fails in any.
     #[inline(always)]
     fn try_normalize(self) -> Option<V4> {
-        let length = self.dot(self).map(f32::sqrt);
-        let recip = length.map(|x| 1.0 / x);
-        recip
-            .iter()
-            .all(|r| r.is_finite() && *r > 0.0)
-            .then(|| self.scale(recip))
+        let squared = self.dot(self);
+        let length = Vec4::new(
+            squared.x.sqrt(),
+            squared.y.sqrt(),
+            squared.z.sqrt(),
+            squared.w.sqrt(),
+        );
+        let recip = Vec4::ONE / length;
+        (recip.is_finite() && recip.cmpgt(Vec4::ZERO).all()).then(|| self.scale(recip))
     }
 }
 
