@@ -58,7 +58,8 @@ pub(crate) struct Work {
     ordered: Vec<(u32, FixedVertexHandle)>,
     /// Lenient verdicts (any neighbours vouch) of the changed points.
     pub(crate) lenient: Vec<(u64, bool)>,
-    pub(crate) verdicts: Vec<(MeshVertex, bool)>,
+    /// Per dirty vertex: the vertex, whether it is consistent, and its flags when tested.
+    pub(crate) verdicts: Vec<(MeshVertex, bool, u8)>,
     pub(crate) scratch: Scratch,
     reinsert: Vec<MeshVertex>,
 }
@@ -322,7 +323,8 @@ impl DepthMesh {
         }
         for &(_, handle) in ordered.iter() {
             let consistent = self.is_supported(handle, Support::Strict, scratch);
-            verdicts.push((*self.all.triangles.vertex(handle).data(), consistent));
+            let vertex = *self.all.triangles.vertex(handle).data();
+            verdicts.push((vertex, consistent, self.all.mark(handle)));
         }
         for &(id, _) in lenient.iter() {
             self.all.set_mark(id, CHANGED | LENIENT, false);
@@ -333,17 +335,26 @@ impl DepthMesh {
     /// Brings the surface in line with the verdicts: first every removal and move (so no
     /// stale position remains), then the insertions.
     fn apply_verdicts(&mut self, work: &mut Work) {
-        for &(vertex, consistent) in &work.verdicts {
-            let Some(old) = self.surface.get(vertex.id) else {
+        for &(vertex, consistent, mark) in &work.verdicts {
+            if mark & IN_SURFACE == 0 {
                 if consistent {
                     work.reinsert.push(vertex);
                 }
                 continue;
-            };
+            }
             if !consistent {
                 self.surface.remove(vertex.id);
                 self.all.set_mark(vertex.id, IN_SURFACE, false);
-            } else if old.pixel != vertex.pixel {
+                continue;
+            }
+            // An unchanged surface member is already where it belongs.
+            let Some(old) = (mark & CHANGED != 0)
+                .then(|| self.surface.get(vertex.id))
+                .flatten()
+            else {
+                continue;
+            };
+            if old.pixel != vertex.pixel {
                 if self.surface.move_vertex(vertex).is_err() {
                     // Its new position still holds a surface vertex that moves away later in
                     // this loop: insert it after all moves.

@@ -121,7 +121,12 @@ proptest! {
         let random_pixel = |rng: &mut super::tests::SplitMix| {
             Vec2::new(rng.next_f32() * 639.0, rng.next_f32() * 479.0)
         };
-        let observation = |id: u64, pixel: Vec2| Observation { id, pixel, depth_m: plane_depth(pixel) };
+        // One point in ten is an outlier (off the plane): the surface then differs from all
+        // points, and inconsistent vertices move, vanish and appear too.
+        let observation = |id: u64, pixel: Vec2| {
+            let outlier = if id % 10 == 3 { 1.6 } else { 1.0 };
+            Observation { id, pixel, depth_m: plane_depth(pixel) * outlier }
+        };
         let mut frame: Vec<Observation> =
             (0..num_points as u64).map(|id| observation(id, random_pixel(&mut rng))).collect();
         let mut mesh = DepthMesh::new(camera(), DepthMeshConfig::default());
