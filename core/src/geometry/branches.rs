@@ -7,24 +7,26 @@ use std::f32::consts::{PI, TAU};
 
 use glam::Vec3;
 
+use super::lanes::V4;
+use super::parent_tube::{ParentTube, onto_parent, onto_parent4};
 use super::topology::{BranchTopology, NONE};
 use super::{AmbientFn, BranchStart, MeshParams, NodeGeom, TreeMesh, any_perpendicular, hash_unit};
 use crate::tree::NodeId;
 
 /// A ring of a generalized cylinder.
 #[derive(Clone, Copy, Debug)]
-struct Ring {
-    center: Vec3,
-    tangent: Vec3,
+pub(super) struct Ring {
+    pub(super) center: Vec3,
+    pub(super) tangent: Vec3,
     /// Unit, perpendicular to `tangent`, carried by parallel transport along the chain.
-    reference: Vec3,
+    pub(super) reference: Vec3,
     /// `tangent × reference`.
-    binormal: Vec3,
-    radius: f32,
+    pub(super) binormal: Vec3,
+    pub(super) radius: f32,
     /// Bark texture coordinates: v along the path, u offset (the per-segment rotation).
-    v: f32,
-    u_offset: f32,
-    ambient: f32,
+    pub(super) v: f32,
+    pub(super) u_offset: f32,
+    pub(super) ambient: f32,
 }
 
 /// The rings of one chain.
@@ -142,99 +144,6 @@ fn scaled_sides(sides: u32, side_scale: f32) -> u32 {
         return sides.max(3);
     }
     ((sides as f32 * side_scale).round() as u32).max(3)
-}
-
-/// Radius of the parent's tube at the ends of internode `node`, as the rings draw it.
-fn end_radius(nodes: &[NodeGeom], topology: &BranchTopology, node: u32, tip_taper: f32) -> f32 {
-    let next = topology.visual_child[node as usize];
-    if next == NONE {
-        0.5 * nodes[node as usize].diameter * tip_taper
-    } else {
-        0.5 * nodes[next as usize].diameter
-    }
-}
-
-/// One internode of a parent tube: axis from `a` to `b`, radius from `radius_a` to `radius_b`.
-#[derive(Clone, Copy, Debug)]
-struct TubeSegment {
-    a: Vec3,
-    /// b − a.
-    ab: Vec3,
-    /// 1 / |b − a|², 0 for a degenerate segment.
-    inverse_length_squared: f32,
-    radius_a: f32,
-    /// radius_b − radius_a.
-    radius_change: f32,
-    radius_b: f32,
-}
-
-impl TubeSegment {
-    fn new(a: Vec3, b: Vec3, radius_a: f32, radius_b: f32) -> Self {
-        let ab = b - a;
-        let length_squared = ab.length_squared();
-        TubeSegment {
-            a,
-            ab,
-            inverse_length_squared: if length_squared > 1e-12 {
-                1.0 / length_squared
-            } else {
-                0.0
-            },
-            radius_a,
-            radius_change: radius_b - radius_a,
-            radius_b,
-        }
-    }
-
-    /// The axis point closest to `point` and the tube radius there.
-    fn closest(&self, point: Vec3) -> (Vec3, f32) {
-        let t = ((point - self.a).dot(self.ab) * self.inverse_length_squared).clamp(0.0, 1.0);
-        (self.a + self.ab * t, self.radius_a + self.radius_change * t)
-    }
-}
-
-/// The parent surface near a branching point, as the parent's rings draw it: the internode the
-/// branch grows from and its continuation along the thickest path.
-#[derive(Clone, Copy, Debug)]
-pub(crate) struct ParentTube {
-    below: TubeSegment,
-    above: Option<TubeSegment>,
-}
-
-impl ParentTube {
-    fn new(nodes: &[NodeGeom], topology: &BranchTopology, parent: u32, tip_taper: f32) -> Self {
-        let segment = |node: u32| {
-            let n = &nodes[node as usize];
-            let radius_b = end_radius(nodes, topology, node, tip_taper);
-            TubeSegment::new(n.start, n.end, 0.5 * n.diameter, radius_b)
-        };
-        let continuation = topology.visual_child[parent as usize];
-        ParentTube {
-            below: segment(parent),
-            above: (continuation != NONE).then(|| segment(continuation)),
-        }
-    }
-
-    /// Radius of the tube at the branching point.
-    fn joint_radius(&self) -> f32 {
-        self.below.radius_b
-    }
-
-    /// The axis point closest to `point` and the tube radius there.
-    fn at(&self, point: Vec3) -> (Vec3, f32) {
-        let best = self.below.closest(point);
-        match &self.above {
-            Some(s) => {
-                let candidate = s.closest(point);
-                if candidate.0.distance_squared(point) < best.0.distance_squared(point) {
-                    candidate
-                } else {
-                    best
-                }
-            }
-            None => best,
-        }
-    }
 }
 
 /// Carries `reference` from a ring at `from` with tangent `from_tangent` to the next ring by the
@@ -442,15 +351,33 @@ impl RingFrames {
             let (reference, binormal) = (ring.reference, ring.binormal);
             match laid {
                 Some((tube, shrink)) if ring_index == 0 => {
-                    for (k, &(cos, sin)) in table.iter().enumerate() {
-                        let direction = reference * cos + binormal * sin;
-                        let position = onto_parent(tube, ring, direction, shrink);
-                        mesh.push_vertex(
-                            position,
-                            direction,
-                            [k as f32 * du + ring.u_offset, ring.v],
-                            ring.ambient,
-                        );
+                    // Four vertices at a time, the rest (and any group with a degenerate
+                    // vertex) one by one.
+                    let mut k = 0;
+                    while k < table.len() {
+                        let group = table.get(k..k + 4).and_then(|cs| {
+                            let directions: [Vec3; 4] = std::array::from_fn(|i| {
+                                let (cos, sin) = cs[i];
+                                reference * cos + binormal * sin
+                            });
+                            onto_parent4(tube, ring, V4::gather(directions), shrink)
+                                .map(|positions| (directions, positions))
+                        });
+                        let Some((directions, positions)) = group else {
+                            let (cos, sin) = table[k];
+                            let direction = reference * cos + binormal * sin;
+                            let position = onto_parent(tube, ring, direction, shrink);
+                            let uv = [k as f32 * du + ring.u_offset, ring.v];
+                            mesh.push_vertex(position, direction, uv, ring.ambient);
+                            k += 1;
+                            continue;
+                        };
+                        for (i, direction) in directions.into_iter().enumerate() {
+                            let position = Vec3::from(positions.lane(i));
+                            let uv = [(k + i) as f32 * du + ring.u_offset, ring.v];
+                            mesh.push_vertex(position, direction, uv, ring.ambient);
+                        }
+                        k += 4;
                     }
                 }
                 _ => {
@@ -473,32 +400,6 @@ impl RingFrames {
             }
         }
     }
-}
-
-/// Lays a vertex of a lateral branch's first ring onto its parent's surface: slides it along
-/// the branch tangent until it leaves the parent tube, then projects it radially onto the
-/// tube (shrunk to the mid-radius of the parent's polygonal contour, so no gap shows).
-fn onto_parent(tube: &ParentTube, ring: &Ring, direction: Vec3, shrink: f32) -> Vec3 {
-    let start = ring.center + direction * ring.radius;
-    // One linearised step along the tangent to where the vertex leaves the tube; the radial
-    // projection below then puts it exactly on the surface.
-    let (axis, radius) = tube.at(start);
-    let offset = start - axis;
-    let distance = offset.length();
-    let gap = radius * shrink - distance;
-    let slide = if gap > 1e-4 * radius && distance > 1e-9 {
-        let rate = ring.tangent.dot(offset / distance).max(0.25);
-        (gap / rate).min(3.0 * tube.joint_radius())
-    } else {
-        0.0
-    };
-    let point = start + ring.tangent * slide;
-    let (axis, radius) = tube.at(point);
-    let outward = (point - axis)
-        .try_normalize()
-        .or_else(|| direction.try_normalize())
-        .unwrap_or(Vec3::X);
-    axis + outward * radius * shrink
 }
 
 fn chain_triangles(chain: &ChainRings, side_scale: f32) -> usize {

@@ -19,9 +19,11 @@
 //! to be cast to GPU buffers.
 
 mod branches;
+mod lanes;
 pub mod leaves;
 mod looks;
 mod mesher;
+mod parent_tube;
 mod petiole;
 pub mod synthetic;
 pub mod textures;

@@ -13,6 +13,7 @@ use glam::{Vec3, Vec4};
 
 use super::LeafParams;
 use super::any_perpendicular;
+use super::lanes::V4;
 
 /// Where a petiole starts: the point on the branch surface, the branch heading there, the unit
 /// direction from the branch axis to the point, and the ambient light (which scales the rates).
@@ -135,8 +136,8 @@ impl Petiole {
     /// frame of one of them degenerates (then [`Petiole::blade`] handles each with its
     /// fallbacks).
     pub(crate) fn blades4(&self, at: &[Attachment; 4]) -> Option<[Blade; 4]> {
-        let heading = V4::gather(at, |a| a.heading);
-        let radial = V4::gather(at, |a| a.radial);
+        let heading = V4::gather(at.map(|a| a.heading));
+        let radial = V4::gather(at.map(|a| a.radial));
         let mut h = heading
             .scale(Vec4::splat(self.cos_insertion))
             .add(radial.scale(Vec4::splat(self.sin_insertion)));
@@ -151,7 +152,7 @@ impl Petiole {
             Vec4::splat(self.turn_rate),
         );
         let one = Vec4::ONE;
-        let mut position = V4::gather(at, |a| a.point);
+        let mut position = V4::gather(at.map(|a| a.point));
         for _ in 0..self.steps {
             let u = h.cross(l);
             let (h_t, l_t, l_h) = (h.dot(target), l.dot(target), l.dot(h));
@@ -193,96 +194,6 @@ impl Petiole {
             normal: normal.lane(i),
         };
         Some([blade(0), blade(1), blade(2), blade(3)])
-    }
-}
-
-/// Four vectors, one per lane of glam's `Vec4` (SIMD on x86-64), stored by component. The
-/// operations repeat glam's `Vec3` arithmetic operation for operation, lane by lane.
-#[derive(Clone, Copy)]
-struct V4 {
-    x: Vec4,
-    y: Vec4,
-    z: Vec4,
-}
-
-impl V4 {
-    #[inline(always)]
-    fn gather(at: &[Attachment; 4], f: impl Fn(&Attachment) -> Vec3) -> V4 {
-        let v = [f(&at[0]), f(&at[1]), f(&at[2]), f(&at[3])];
-        V4 {
-            x: Vec4::new(v[0].x, v[1].x, v[2].x, v[3].x),
-            y: Vec4::new(v[0].y, v[1].y, v[2].y, v[3].y),
-            z: Vec4::new(v[0].z, v[1].z, v[2].z, v[3].z),
-        }
-    }
-
-    #[inline(always)]
-    fn splat(v: Vec3) -> V4 {
-        V4 {
-            x: Vec4::splat(v.x),
-            y: Vec4::splat(v.y),
-            z: Vec4::splat(v.z),
-        }
-    }
-
-    #[inline(always)]
-    fn lane(&self, i: usize) -> [f32; 3] {
-        [self.x[i], self.y[i], self.z[i]]
-    }
-
-    #[inline(always)]
-    fn add(self, o: V4) -> V4 {
-        V4 {
-            x: self.x + o.x,
-            y: self.y + o.y,
-            z: self.z + o.z,
-        }
-    }
-
-    #[inline(always)]
-    fn sub(self, o: V4) -> V4 {
-        V4 {
-            x: self.x - o.x,
-            y: self.y - o.y,
-            z: self.z - o.z,
-        }
-    }
-
-    #[inline(always)]
-    fn scale(self, s: Vec4) -> V4 {
-        V4 {
-            x: self.x * s,
-            y: self.y * s,
-            z: self.z * s,
-        }
-    }
-
-    #[inline(always)]
-    fn dot(self, o: V4) -> Vec4 {
-        (self.x * o.x) + (self.y * o.y) + (self.z * o.z)
-    }
-
-    #[inline(always)]
-    fn cross(self, o: V4) -> V4 {
-        V4 {
-            x: self.y * o.z - o.y * self.z,
-            y: self.z * o.x - o.z * self.x,
-            z: self.x * o.y - o.x * self.y,
-        }
-    }
-
-    /// glam's `try_normalize` in every lane; `None` when it fails in any.
-    #[inline(always)]
-    fn try_normalize(self) -> Option<V4> {
-        let squared = self.dot(self);
-        let length = Vec4::new(
-            squared.x.sqrt(),
-            squared.y.sqrt(),
-            squared.z.sqrt(),
-            squared.w.sqrt(),
-        );
-        let recip = Vec4::ONE / length;
-        (recip.is_finite() && recip.cmpgt(Vec4::ZERO).all()).then(|| self.scale(recip))
     }
 }
 
