@@ -57,14 +57,16 @@ pub fn demo_session(footage: &Footage, footage_ref: PathBuf) -> anyhow::Result<S
         } else if step == at(0.3) {
             events.push(touch(TouchPhase::End, 0, stroke_pixel));
         }
-        // Stroke 2: from the top again, up and to the left, with a wider brush half way.
+        // Stroke 2: from the top again, first straight up (inside the top bud's perception
+        // cone), then curving to the left, with a wider brush half way.
         if step == at(0.35)
             && let Some(p) = top_pixel
         {
             stroke_pixel = p;
             events.push(touch(TouchPhase::Start, 0, p));
         } else if step > at(0.35) && step < at(0.55) {
-            stroke_pixel += Vec2::new(-4.0, -4.0);
+            let turn = (step - at(0.35)) as f32 / (at(0.55) - at(0.35)) as f32;
+            stroke_pixel += Vec2::new(-6.0 * turn, -5.0 * (1.0 - 0.5 * turn));
             events.push(touch(TouchPhase::Move, 0, stroke_pixel));
             if step == at(0.45) {
                 let mut p = state.params.clone();
