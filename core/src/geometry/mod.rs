@@ -15,6 +15,11 @@
 //! - **Levels of detail** ([`Lod`]): about 100%, 40% and 15% of the triangles, by fewer sides,
 //!   dropping the thinnest branches and drawing a prefix of the randomly ordered leaf buffer.
 //!
+//! Building: [`build_meshes`] makes every level (export, LOD switching); [`build_level`] makes
+//! only the level a renderer draws, plus the whole leaf and fruit buffers; a [`Mesher`] kept
+//! between calls reuses its working memory, and meshes passed back in reuse their buffers, so
+//! re-meshing after an edit allocates nothing once the buffers have grown.
+//!
 //! Space: world metres, Y up, as the skeleton. All arrays are flat `[f32; N]` / `u32` vectors, ready
 //! to be cast to GPU buffers.
 
