@@ -47,7 +47,9 @@ pub(crate) type IdMap<V> = HashMap<u64, V, BuildHasherDefault<IdHasher>>;
 pub(crate) type IdSet = HashSet<u64, BuildHasherDefault<IdHasher>>;
 
 /// Point location starts from the hints this module hands over (grid cells, former
-/// neighbours); spade's own generator only remembers the last vertex it found.
+/// neighbours); spade's own generator only remembers the last vertex it found. It keeps no
+/// positions of its own, which in-place moves rely on: spade reads a vertex's position from
+/// its data only (the hierarchy generator stores copies, so it is not used here).
 pub(crate) type Triangles =
     DelaunayTriangulation<MeshVertex, (), (), (), LastUsedVertexHintGenerator>;
 
