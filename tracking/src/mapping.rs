@@ -10,7 +10,7 @@ use crate::map::Observation;
 use crate::pose::Se3;
 use crate::tracker::{Tracker, TrackerError};
 use glam::{DVec3, Vec2};
-use std::collections::{HashMap, HashSet};
+use std::collections::{BTreeMap, HashMap, HashSet};
 
 /// Keyframe pyramids kept for the local-map search.
 const MAX_KEYFRAME_PYRAMIDS: usize = 40;
@@ -201,7 +201,8 @@ impl Tracker {
         }
         wanted.sort_by_key(|w| std::cmp::Reverse(w.0));
         wanted.truncate(self.config.max_local_search);
-        let mut by_keyframe: HashMap<usize, Vec<(u64, Vec2, Vec2)>> = HashMap::new();
+        // Ordered by keyframe: tracks must come out in the same order on every run.
+        let mut by_keyframe: BTreeMap<usize, Vec<(u64, Vec2, Vec2)>> = BTreeMap::new();
         for (kf, id, from, guess) in wanted {
             by_keyframe.entry(kf).or_default().push((id, from, guess));
         }

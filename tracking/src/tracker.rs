@@ -108,6 +108,7 @@ pub struct Tracker {
 
 impl Tracker {
     pub fn new(camera: Camera, config: TrackerConfig) -> Result<Self, TrackerError> {
+        cv::configure_single_thread();
         Ok(Self {
             camera,
             config,
