@@ -31,6 +31,7 @@ struct DesktopApp {
     gfx: Option<Gfx>,
     error: Option<anyhow::Error>,
     meshed_revision: Option<u64>,
+    tree_mesher: crate::tree_model::TreeMesher,
     started: Instant,
     session_path: PathBuf,
 }
@@ -53,6 +54,7 @@ pub fn run_window(
         gfx: None,
         error: None,
         meshed_revision: None,
+        tree_mesher: Default::default(),
         started: Instant::now(),
         session_path,
     };
@@ -185,11 +187,12 @@ impl DesktopApp {
             if self.meshed_revision != revision {
                 let t = Instant::now();
                 // The seedling is planted once the ground is found.
-                let mesh = match revision {
-                    Some(_) => crate::tree_model::mesh_of(&self.player.design.tree),
-                    None => Default::default(),
-                };
-                gfx.renderer.set_tree(&gfx.gpu, &mesh);
+                match revision {
+                    Some(_) => gfx
+                        .renderer
+                        .set_tree(&gfx.gpu, self.tree_mesher.mesh(&self.player.design.tree)),
+                    None => gfx.renderer.set_tree(&gfx.gpu, &Default::default()),
+                }
                 self.player.ui.budget.meshing_ms = t.elapsed().as_secs_f32() * 1000.0;
                 self.meshed_revision = revision;
             }

@@ -199,6 +199,7 @@ pub fn replay(
     // Everything comes from the recording (poses, ground, tracked points): a replay needs no
     // tracker and gives the same frames on every machine.
     let mut mesher = SceneMesher::new(&footage.intrinsics);
+    let mut tree_mesher = crate::tree_model::TreeMesher::default();
     let mut state = DesignState::new(session.seed, session.parameters.clone());
     let mut meshed_revision = None;
     let mut frame_sha256 = Vec::new();
@@ -231,7 +232,7 @@ pub fn replay(
             continue;
         };
         if meshed_revision != Some(state.revision) {
-            renderer.set_tree(gpu, &crate::tree_model::mesh_of(&state.tree));
+            renderer.set_tree(gpu, tree_mesher.mesh(&state.tree));
             meshed_revision = Some(state.revision);
         }
         let rgba = footage.load_rgba(index)?;

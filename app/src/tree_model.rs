@@ -3,7 +3,7 @@
 //! growth shadow grid), converted to the renderer's vertices.
 
 use glam::Vec3;
-use sylva_core::geometry::{TreeMeshes, build_tree_level};
+use sylva_core::geometry::{Levels, Mesher, TreeMeshes, build_tree_level, mesh_params_for};
 use sylva_core::{Skeleton, Tree};
 
 use crate::render::{LitMesh, LitVertex, TreeMesh};
@@ -62,6 +62,41 @@ pub fn mesh_of(tree: &Tree) -> TreeMesh {
     draw_mesh(&build_tree_level(tree, 0))
 }
 
+/// Re-meshes the tree after every edit with the same working memory: the mesher's scratch, the
+/// core meshes and the renderer's vertices are all kept, so a re-mesh writes into memory the
+/// process already holds (a first build into fresh memory costs over twice as much).
+#[derive(Default)]
+pub struct TreeMesher {
+    mesher: Mesher,
+    meshes: TreeMeshes,
+    mesh: TreeMesh,
+}
+
+impl TreeMesher {
+    /// The drawn mesh of `tree` (level 0 and leaves), as [`mesh_of`] builds it.
+    pub fn mesh(&mut self, tree: &Tree) -> &TreeMesh {
+        let params = mesh_params_for(&tree.species);
+        self.mesher.build_into(
+            &tree.skeleton,
+            &params,
+            &|p| tree.ambient_at(p),
+            Levels::One(0),
+            &mut self.meshes,
+        );
+        match self.meshes.lods.first() {
+            Some(lod) => lit_into(&lod.branches, |uv| uv, &mut self.mesh.branches),
+            None => self.mesh.branches = LitMesh::default(),
+        }
+        lit_into(&self.meshes.leaves, leaf_uv, &mut self.mesh.leaves);
+        &self.mesh
+    }
+}
+
+/// Leaf texture coordinates from the core's to the renderer's (see [`draw_mesh`]).
+fn leaf_uv([u, v]: [f32; 2]) -> [f32; 2] {
+    [u - 0.5, 1.0 - v]
+}
+
 /// The renderer's mesh of `sylva_core` meshes (level 0). Leaf texture coordinates go from
 /// the core's (u across 0..1, v from tip 0 to petiole 1) to the renderer's (x across −½..½,
 /// y from petiole 0 to tip 1).
@@ -71,21 +106,52 @@ pub fn draw_mesh(meshes: &TreeMeshes) -> TreeMesh {
         .first()
         .map(|lod| lit(&lod.branches, |uv| uv))
         .unwrap_or_default();
-    let leaves = lit(&meshes.leaves, |[u, v]| [u - 0.5, 1.0 - v]);
+    let leaves = lit(&meshes.leaves, leaf_uv);
     TreeMesh { branches, leaves }
 }
 
 fn lit(mesh: &sylva_core::geometry::TreeMesh, uv_of: impl Fn([f32; 2]) -> [f32; 2]) -> LitMesh {
-    let vertices = (0..mesh.positions.len())
-        .map(|i| LitVertex {
+    let mut out = LitMesh::default();
+    lit_into(mesh, uv_of, &mut out);
+    out
+}
+
+/// Writes the renderer's vertices of `mesh` into `out`, reusing its buffers.
+fn lit_into(
+    mesh: &sylva_core::geometry::TreeMesh,
+    uv_of: impl Fn([f32; 2]) -> [f32; 2],
+    out: &mut LitMesh,
+) {
+    out.vertices.clear();
+    out.vertices
+        .extend((0..mesh.positions.len()).map(|i| LitVertex {
             position: mesh.positions[i],
             normal: mesh.normals[i],
             ambient: mesh.ambient[i],
             uv: uv_of(mesh.uvs[i]),
-        })
-        .collect();
-    LitMesh {
-        vertices,
-        indices: mesh.indices.clone(),
+        }));
+    out.indices.clear();
+    out.indices.extend_from_slice(&mesh.indices);
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_reusing_mesher_draws_what_a_fresh_build_draws_edit_after_edit() {
+        let mut tree = golden_tree();
+        let mut mesher = TreeMesher::default();
+        for _ in 0..3 {
+            assert_eq!(mesher.mesh(&tree), &mesh_of(&tree));
+            tree.grow(1, None);
+        }
+        // And after the tree shrinks (buffers longer than needed must not leak old data).
+        let cut: Vec<_> = (1..tree.skeleton.len())
+            .filter(|&i| tree.skeleton.internodes[i].order == 1)
+            .map(|i| sylva_core::NodeId(i as u32))
+            .collect();
+        tree.remove_subtrees(&cut);
+        assert_eq!(mesher.mesh(&tree), &mesh_of(&tree));
     }
 }
