@@ -340,8 +340,42 @@ impl DesignState {
             self.changed();
             return;
         }
+        let years_changed = parameters.years != self.params.years;
         self.params = parameters.clone();
         parameters.apply_to(&mut self.tree.species);
+        if years_changed {
+            self.grow_to_age(parameters.years);
+        }
+    }
+
+    /// The years slider: grows the tree autonomously to `years` of age, or ungrows it to the kept
+    /// iteration of that age (part of the parameter change's undo step).
+    fn grow_to_age(&mut self, years: f32) {
+        if !years.is_finite() {
+            return;
+        }
+        let target = self.tree.species.iterations_for_years(years.max(0.0));
+        if target > self.tree.iteration {
+            while self.tree.iteration < target {
+                self.tree.grow(1, None);
+                self.timeline.keep(&self.tree);
+            }
+        } else if target < self.tree.iteration {
+            let earliest = self.timeline.range().map_or(target, |(first, _)| first);
+            if self
+                .timeline
+                .go_to(&mut self.tree, target.max(earliest))
+                .is_err()
+            {
+                return;
+            }
+        } else {
+            return;
+        }
+        self.brush = None;
+        self.bend = None;
+        self.selected = None;
+        self.changed();
     }
 
     /// Autonomous growth (positive) or ungrowing to an earlier kept iteration (negative).

@@ -109,7 +109,10 @@ pub fn sylva_ui(
                     });
             }
             Tab::Years => {
-                ui.add(egui::Slider::new(&mut params.years, 1.0..=40.0).text("Years"));
+                ui.add(
+                    egui::Slider::new(&mut params.years, 1.0..=40.0)
+                        .text("Age (years): grows or ungrows the tree"),
+                );
             }
             Tab::Export => {
                 if ui.button("Export tree (.glb, .json)").clicked() {
