@@ -38,6 +38,9 @@ pub struct Parameters {
     pub gravimorphism: [f32; 2],
     pub branching_angle: f32,
     pub deflection_angle: f32,
+    /// Sketch-based tropism: new branches follow the direction of brush strokes.
+    #[serde(default)]
+    pub sketch_tropism: bool,
     pub years: f32,
     /// Brush radius, metres.
     pub brush_radius: f32,
@@ -78,6 +81,7 @@ impl Parameters {
             ],
             branching_angle: species.branching_angle_deg.to_radians(),
             deflection_angle: species.deflection_angle_deg.to_radians(),
+            sketch_tropism: false,
             years: 5.0,
             brush_radius: 0.12,
             grow_speed: 10.0,
@@ -512,7 +516,11 @@ impl DesignState {
                 return;
             };
             self.history.record(OperationKind::Stroke, &self.tree);
-            self.brush = Some(BrushStroke::new(plane, BrushSettings::default()));
+            let settings = BrushSettings {
+                sketch_tropism: self.params.sketch_tropism,
+                ..BrushSettings::default()
+            };
+            self.brush = Some(BrushStroke::new(plane, settings));
         }
         let time_s = self.time_s;
         if let Some(brush) = self.brush.as_mut() {

@@ -156,6 +156,10 @@ fn architecture_ui(ui: &mut Ui, params: &mut crate::state::Parameters) {
             ui.add(
                 egui::Slider::new(&mut params.deflection_angle, 0.0..=0.8).text("Deflection angle"),
             );
+            ui.checkbox(
+                &mut params.sketch_tropism,
+                "Tropism from the stroke direction",
+            );
         });
     });
 }

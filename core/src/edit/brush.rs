@@ -61,9 +61,15 @@ pub struct BrushSettings {
     pub points_per_internode_cube: f32,
     /// Sketch-based tropism: points carry the stroke direction as the tropism of their bud.
     pub sketch_tropism: bool,
+    /// With sketch tropism, the least weight β of the stroke direction for the buds it feeds
+    /// (see [`crate::environment::AttractionPoints::sketch_tropism_weight`]).
+    pub sketch_tropism_weight: f32,
     /// Depth constraint: keep only points within this distance of the brush plane (metres).
     pub depth_limit_m: Option<f32>,
 }
+
+/// Default least weight of the stroke direction under sketch tropism.
+pub const SKETCH_TROPISM_WEIGHT: f32 = 0.8;
 
 impl Default for BrushSettings {
     fn default() -> Self {
@@ -71,6 +77,7 @@ impl Default for BrushSettings {
             points_per_internode: 3.0,
             points_per_internode_cube: 0.5,
             sketch_tropism: false,
+            sketch_tropism_weight: SKETCH_TROPISM_WEIGHT,
             depth_limit_m: None,
         }
     }
@@ -199,10 +206,11 @@ impl BrushStroke {
                 continue;
             }
             match direction.filter(|_| self.settings.sketch_tropism) {
-                Some(d) => tree
-                    .environment
-                    .attraction
-                    .add_persistent_with_tropism(p, d),
+                Some(d) => {
+                    let attraction = &mut tree.environment.attraction;
+                    attraction.sketch_tropism_weight = self.settings.sketch_tropism_weight;
+                    attraction.add_persistent_with_tropism(p, d)
+                }
                 None => tree.environment.attraction.add_persistent(p),
             }
             added += 1;

@@ -24,6 +24,15 @@ pub struct AttractionPoint {
 #[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct AttractionPoints {
     pub points: Vec<AttractionPoint>,
+    /// Sketch-based tropism: a bud fed by points that carry a stroke direction weighs that
+    /// direction (T) at least this much in H' = αH + βT + γE, so branches follow strokes even
+    /// on species with little tropism (β). 0 when no stroke asks for it.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub sketch_tropism_weight: f32,
+}
+
+fn is_zero(x: &f32) -> bool {
+    *x == 0.0
 }
 
 impl AttractionPoints {

@@ -165,6 +165,11 @@ fn grow_shoot(
             carried = t.or(carried);
         }
         let t = tropism(tree, heading, order, bud_override.or(carried));
+        // A stroke's direction (sketch tropism) weighs at least what the stroke asks for.
+        let beta = match (bud_override, carried) {
+            (None, Some(_)) => beta.max(tree.environment.attraction.sketch_tropism_weight),
+            _ => beta,
+        };
         let new_heading = (alpha * heading + beta * t + gamma * environment)
             .try_normalize()
             .unwrap_or(heading);
