@@ -41,6 +41,12 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
     if options.autonomous {
         generate_points(tree, scratch, r, perception, cos_half);
     }
+    if let Some(constraint) = tree.environment.depth_constraint {
+        tree.environment
+            .attraction
+            .points
+            .retain(|p| constraint.allows(p.position));
+    }
     if let Some((scene, SceneMode::GrowInFront)) = options.scene {
         tree.environment
             .attraction
