@@ -26,6 +26,9 @@ pub struct SceneFrame {
     pub observations: Vec<Observation>,
     /// The depth mesh of the tracked points in the world (empty without a pose).
     pub occluder: OccluderMesh,
+    /// Time spent tracking this frame and updating the depth mesh, milliseconds (decoding the
+    /// image excluded).
+    pub tracking_ms: f32,
 }
 
 /// The incremental depth mesh of the tracked points, turned into the renderer's occluder. Live
@@ -126,11 +129,13 @@ mod desktop {
                 match event {
                     SourceEvent::Frame(frame) => {
                         let up = self.sequence.up_in_camera_at(frame.timestamp_s);
+                        let started = std::time::Instant::now();
                         let output = self
                             .tracker
                             .track(&frame, up.map(|u| u * 9.81))
                             .with_context(|| format!("tracking frame {}", frame.index))?;
-                        let scene = self.scene_of(&output);
+                        let mut scene = self.scene_of(&output);
+                        scene.tracking_ms = started.elapsed().as_secs_f32() * 1000.0;
                         self.push_at(frame.index, scene);
                     }
                     SourceEvent::Skipped {
@@ -196,6 +201,7 @@ mod desktop {
                 ground,
                 observations,
                 occluder,
+                tracking_ms: 0.0,
             }
         }
     }
