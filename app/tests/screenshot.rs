@@ -63,8 +63,9 @@ fn start_xvfb() -> (Killed, String) {
     (Killed(child), display)
 }
 
-/// Runs the app paused at `frame` and takes a screenshot of the screen.
-fn screenshot(display: &str, frame: usize, dir: &Path) -> RgbaImage {
+/// Runs the app paused at `frame` and takes a screenshot once the window shows that frame of the
+/// footage (the app first tracks the frames before it; on a loaded machine that takes a while).
+fn screenshot(display: &str, frame: usize, dir: &Path, image: &RgbaImage) -> RgbaImage {
     let app = Command::new(env!("CARGO_BIN_EXE_sylva"))
         .arg("view")
         .arg(demo())
@@ -77,15 +78,66 @@ fn screenshot(display: &str, frame: usize, dir: &Path) -> RgbaImage {
         .spawn()
         .expect("start sylva");
     let _app = Killed(app);
-    std::thread::sleep(Duration::from_secs(12));
     let path = dir.join(format!("screenshot-{frame}.png"));
-    let status = Command::new("import")
-        .args(["-display", display, "-window", "root"])
-        .arg(&path)
-        .status()
-        .expect("ImageMagick's import is required for this test");
-    assert!(status.success(), "import failed");
-    image::open(&path).expect("screenshot").to_rgba8()
+    let mut shown = 0.0;
+    for _ in 0..SCREENSHOT_TRIES {
+        std::thread::sleep(Duration::from_secs(3));
+        let status = Command::new("import")
+            .args(["-display", display, "-window", "root"])
+            .arg(&path)
+            .status()
+            .expect("ImageMagick's import is required for this test");
+        assert!(status.success(), "import failed");
+        let shot = image::open(&path).expect("screenshot").to_rgba8();
+        shown = footage_shown(&shot, image);
+        if shown >= 0.8 {
+            // One more frame's worth of time so the tree is drawn over the footage too.
+            std::thread::sleep(Duration::from_secs(1));
+            let status = Command::new("import")
+                .args(["-display", display, "-window", "root"])
+                .arg(&path)
+                .status()
+                .expect("import");
+            assert!(status.success(), "import failed");
+            return image::open(&path).expect("screenshot").to_rgba8();
+        }
+    }
+    panic!(
+        "after {} s the window shows only {:.0} % of footage frame {frame} ({})",
+        3 * SCREENSHOT_TRIES,
+        shown * 100.0,
+        path.display()
+    );
+}
+
+/// Screenshot attempts, 3 s apart.
+const SCREENSHOT_TRIES: usize = 20;
+
+/// Fraction of a 12 × 9 grid of view pixels where the screenshot shows the footage image (the
+/// tree covers few of them).
+fn footage_shown(shot: &RgbaImage, image: &RgbaImage) -> f32 {
+    let k = Footage::open(&demo()).expect("demo").intrinsics;
+    let region = letterbox(WINDOW, &k);
+    let mut same = 0;
+    for j in 0..9 {
+        for i in 0..12 {
+            let (fu, fv) = ((i as f32 + 0.5) / 12.0, (j as f32 + 0.5) / 9.0);
+            let x = (region[0] + fu * region[2]) as u32;
+            let y = (region[1] + fv * region[3]) as u32;
+            let u = ((fu * image.width() as f32) as u32).min(image.width() - 1);
+            let v = ((fv * image.height() as f32) as u32).min(image.height() - 1);
+            let (Some(s), b) = (shot.get_pixel_checked(x, y), image.get_pixel(u, v)) else {
+                continue;
+            };
+            same += usize::from(
+                s.0.iter()
+                    .zip(b.0.iter())
+                    .take(3)
+                    .all(|(a, b)| a.abs_diff(*b) <= 45),
+            );
+        }
+    }
+    same as f32 / 108.0
 }
 
 /// The trunk of the sapling the app plants at the ground origin, at `fraction` of its height.
@@ -194,12 +246,12 @@ fn under_xvfb_the_window_shows_a_tree_that_stays_on_the_ground_as_the_camera_mov
     let (_xvfb, display) = start_xvfb();
     let mut eyes = Vec::new();
     for frame in [60, 200] {
-        let shot = screenshot(&display, frame, &dir);
+        let image = footage.load_rgba(frame).expect("frame image");
+        let shot = screenshot(&display, frame, &dir, &image);
         let pose = footage.frames[frame]
             .world_from_camera
             .expect("ground truth pose");
         let camera = ViewCamera::new(footage.intrinsics, pose);
-        let image = footage.load_rgba(frame).expect("frame image");
         let (fraction, num_samples) =
             tree_on_trunk(&shot, &camera, &image, Vec3::ZERO, &truth_from_tracked);
         assert!(
