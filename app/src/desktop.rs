@@ -13,6 +13,7 @@ use winit::window::{Window, WindowId};
 
 use crate::footage::Footage;
 use crate::player::Player;
+use crate::render::resources::letterbox;
 use crate::render::{FrameView, Gpu, Renderer};
 
 struct Gfx {
@@ -32,6 +33,8 @@ struct DesktopApp {
     error: Option<anyhow::Error>,
     meshed_revision: Option<u64>,
     tree_mesher: crate::tree_model::TreeMesher,
+    /// The camera of the 3D view outside AR (framed on the tree when the view opens).
+    orbit: Option<crate::ui::orbit::OrbitCamera>,
     started: Instant,
     session_path: PathBuf,
 }
@@ -55,6 +58,7 @@ pub fn run_window(
         error: None,
         meshed_revision: None,
         tree_mesher: Default::default(),
+        orbit: None,
         started: Instant::now(),
         session_path,
     };
@@ -181,7 +185,32 @@ impl DesktopApp {
         let size = (gfx.config.width, gfx.config.height);
         let render_started = Instant::now();
         let mut encoder = gfx.gpu.device.create_command_encoder(&Default::default());
-        if let Some(camera) = self.player.camera() {
+        if self.player.ui.orbit_view {
+            // Outside AR: the tree alone on a lawn, seen by the orbiting camera.
+            let tree = &self.player.design.tree;
+            let orbit = *self.orbit.get_or_insert_with(|| {
+                let (mut min, mut max) = (glam::Vec3::splat(f32::MAX), glam::Vec3::splat(f32::MIN));
+                for n in &tree.skeleton.internodes {
+                    min = min.min(n.start.min(n.end));
+                    max = max.max(n.start.max(n.end));
+                }
+                crate::ui::orbit::OrbitCamera::framing(min, max)
+            });
+            if self.meshed_revision != Some(self.player.design.revision) {
+                let t = Instant::now();
+                gfx.renderer.set_tree(&gfx.gpu, self.tree_mesher.mesh(tree));
+                self.player.ui.budget.meshing_ms = t.elapsed().as_secs_f32() * 1000.0;
+                self.meshed_revision = Some(self.player.design.revision);
+            }
+            let camera = orbit.camera(self.player.footage.intrinsics);
+            gfx.renderer.render(
+                &gfx.gpu,
+                &mut encoder,
+                &target,
+                size,
+                &FrameView::tree_only(camera),
+            );
+        } else if let Some(camera) = self.player.camera() {
             let revision =
                 Some(self.player.design.revision).filter(|_| self.player.ui.ground_found);
             if self.meshed_revision != revision {
@@ -216,10 +245,18 @@ impl DesktopApp {
         let raw = gfx.egui_state.take_egui_input(&gfx.window);
         let intrinsics = self.player.footage.intrinsics;
         let player = &mut self.player;
+        let orbit = &mut self.orbit;
         let output = gfx.egui_ctx.run_ui(raw, |ui| {
             let mut events = Vec::new();
             let view = crate::ui::sylva_ui(ui, &mut player.ui, &player.design, &mut events);
-            crate::ui::touch::view_touches_ui(ui, view, size, &intrinsics, &mut events);
+            match orbit.as_mut().filter(|_| player.ui.orbit_view) {
+                Some(orbit) => {
+                    let focal =
+                        letterbox(size, &intrinsics)[2] / intrinsics.width as f32 * intrinsics.fx;
+                    crate::ui::orbit::orbit_view_ui(ui, view, orbit, focal);
+                }
+                None => crate::ui::touch::view_touches_ui(ui, view, size, &intrinsics, &mut events),
+            }
             for e in events {
                 player.input(e);
             }
@@ -246,7 +283,7 @@ impl DesktopApp {
             &screen,
         );
         {
-            let load = if self.player.camera().is_some() {
+            let load = if self.player.ui.orbit_view || self.player.camera().is_some() {
                 wgpu::LoadOp::Load
             } else {
                 wgpu::LoadOp::Clear(wgpu::Color::BLACK)

@@ -5,6 +5,7 @@
 //! UI functions never change the design directly: they emit [`InputEvent`]s, which the caller
 //! applies and records, so sessions capture every edit.
 
+pub mod orbit;
 pub mod touch;
 pub mod widgets;
 
@@ -44,6 +45,8 @@ pub struct UiState {
     pub ground_found: bool,
     pub budget: FrameBudget,
     pub show_debug: bool,
+    /// The tree alone, outside AR, in a view that orbits, pans and zooms.
+    pub orbit_view: bool,
     pub export_requested: bool,
     pub species_names: Vec<String>,
 }
@@ -59,6 +62,7 @@ impl Default for UiState {
             ground_found: false,
             budget: FrameBudget::default(),
             show_debug: false,
+            orbit_view: false,
             export_requested: false,
             species_names: crate::state::species_names(),
         }
@@ -232,6 +236,7 @@ fn playback_ui(ui: &mut Ui, state: &mut UiState) {
             state.seek_to = Some(frame);
         }
         ui.checkbox(&mut state.show_debug, "Debug views");
+        ui.checkbox(&mut state.orbit_view, "3D view (outside AR)");
     });
 }
 
