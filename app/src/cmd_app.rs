@@ -32,6 +32,9 @@ pub struct ViewArgs {
     /// Start paused.
     #[arg(long)]
     pub paused: bool,
+    /// Start in the 3D view outside AR (orbit, pan, zoom) instead of the camera view.
+    #[arg(long)]
+    pub orbit: bool,
 }
 
 /// Finds the demo sequence from the current folder or the workspace the binary was built in.
@@ -59,7 +62,7 @@ fn has_display() -> bool {
 pub fn demo() -> anyhow::Result<()> {
     let sequence = demo_sequence()?;
     if has_display() {
-        match open_window(&sequence, 0, false) {
+        match open_window(&sequence, WindowStart::default()) {
             Ok(()) => return Ok(()),
             Err(e) => eprintln!("no window ({e:#}); rendering frames instead"),
         }
@@ -85,12 +88,27 @@ pub fn demo() -> anyhow::Result<()> {
     Ok(())
 }
 
-fn open_window(sequence: &Path, frame: usize, paused: bool) -> anyhow::Result<()> {
+/// How the window starts.
+#[derive(Clone, Copy, Debug, Default)]
+struct WindowStart {
+    frame: usize,
+    paused: bool,
+    orbit: bool,
+}
+
+fn open_window(sequence: &Path, start: WindowStart) -> anyhow::Result<()> {
     let footage = Footage::open(sequence)?;
     std::fs::create_dir_all("out").context("cannot create out/")?;
     let session_path = PathBuf::from("out/last-session.json");
     let footage_ref = std::fs::canonicalize(sequence).unwrap_or_else(|_| sequence.to_owned());
-    crate::desktop::run_window(footage, footage_ref, session_path, frame, paused)
+    crate::desktop::run_window(
+        footage,
+        footage_ref,
+        session_path,
+        start.frame,
+        start.paused,
+        start.orbit,
+    )
 }
 
 /// `sylva view SEQUENCE` / `sylva view --camera N`.
@@ -104,7 +122,14 @@ pub fn view(args: ViewArgs) -> anyhow::Result<()> {
         Some(s) => s,
         None => demo_sequence()?,
     };
-    open_window(&sequence, args.frame, args.paused)
+    open_window(
+        &sequence,
+        WindowStart {
+            frame: args.frame,
+            paused: args.paused,
+            orbit: args.orbit,
+        },
+    )
 }
 
 /// `sylva replay SESSION --out DIR`.

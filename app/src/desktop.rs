@@ -46,11 +46,13 @@ pub fn run_window(
     session_path: PathBuf,
     first_frame: usize,
     paused: bool,
+    orbit_view: bool,
 ) -> anyhow::Result<()> {
     let event_loop = EventLoop::new().context("cannot connect to a display")?;
     event_loop.set_control_flow(winit::event_loop::ControlFlow::Poll);
     let mut player = Player::new(footage, footage_ref)?;
     player.frame = first_frame.min(player.footage.len().saturating_sub(1));
+    player.ui.orbit_view = orbit_view;
     player.ui.playing = !paused;
     let mut app = DesktopApp {
         player,
