@@ -117,28 +117,34 @@ impl ShadowGrid {
         self.ensure_index_covers(lo >> BRICK_SHIFT, hi >> BRICK_SHIFT);
         for q in 0..=q_max {
             let delta = sign * self.level_units[q as usize];
-            let y = top.y - q;
-            for z in (top.z - q)..=(top.z + q) {
-                self.add_to_row(top.x - q, top.x + q, y, z, delta);
-            }
+            let lo = IVec3::new(top.x - q, top.y - q, top.z - q);
+            let hi = IVec3::new(top.x + q, top.y - q, top.z + q);
+            self.add_to_layer(lo, hi, delta);
         }
     }
 
-    /// Adds `delta` to voxels x0..=x1 of row (y, z), one contiguous run per brick.
-    fn add_to_row(&mut self, x0: i32, x1: i32, y: i32, z: i32, delta: i32) {
-        let (by, bz) = (y >> BRICK_SHIFT, z >> BRICK_SHIFT);
-        let row_offset = BRICK * ((y & (BRICK - 1)) + BRICK * (z & (BRICK - 1)));
-        let mut x = x0;
-        while x <= x1 {
-            let bx = x >> BRICK_SHIFT;
-            let run_end = x1.min((bx << BRICK_SHIFT) + BRICK - 1);
-            let brick = self.brick_at(IVec3::new(bx, by, bz));
-            let base = (row_offset + (x & (BRICK - 1))) as usize;
-            let len = (run_end - x + 1) as usize;
-            for value in &mut self.brick_values_mut(brick)[base..base + len] {
-                *value += delta;
+    /// Adds `delta` to the voxels `lo..=hi` of one horizontal layer (`lo.y == hi.y`), brick by
+    /// brick: each brick the square touches is looked up once, then its rows are contiguous runs.
+    fn add_to_layer(&mut self, lo: IVec3, hi: IVec3, delta: i32) {
+        let y = lo.y;
+        let (by, local_y) = (y >> BRICK_SHIFT, y & (BRICK - 1));
+        for bz in (lo.z >> BRICK_SHIFT)..=(hi.z >> BRICK_SHIFT) {
+            let z0 = lo.z.max(bz << BRICK_SHIFT);
+            let z1 = hi.z.min((bz << BRICK_SHIFT) + BRICK - 1);
+            for bx in (lo.x >> BRICK_SHIFT)..=(hi.x >> BRICK_SHIFT) {
+                let x0 = lo.x.max(bx << BRICK_SHIFT);
+                let x1 = hi.x.min((bx << BRICK_SHIFT) + BRICK - 1);
+                let brick = self.brick_at(IVec3::new(bx, by, bz));
+                let values = self.brick_values_mut(brick);
+                let len = (x1 - x0 + 1) as usize;
+                for z in z0..=z1 {
+                    let base = (BRICK * (local_y + BRICK * (z & (BRICK - 1))) + (x0 & (BRICK - 1)))
+                        as usize;
+                    for value in &mut values[base..base + len] {
+                        *value += delta;
+                    }
+                }
             }
-            x = run_end + 1;
         }
     }
 
