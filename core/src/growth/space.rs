@@ -66,15 +66,17 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
             .iter()
             .map(|p| !scratch.node_grid.any_within(p.position, r)),
     );
-    // Perception: each surviving point feeds its closest perceiving bud. Only competing buds
-    // enter the grid; cells of half the perception radius keep the scanned volume near the
-    // sphere's.
+    // Perception: each surviving point feeds its closest perceiving bud. The grid holds the
+    // nodes with at least one competing bud (a node's buds share its position, so one distance
+    // serves them all; they are tried in bud order, as before); cells of half the perception
+    // radius keep the scanned volume near the sphere's.
     scratch.positions.clear();
     scratch.competing.clear();
-    for (i, bud) in scratch.buds.iter().enumerate() {
-        if bud.competes {
-            scratch.positions.push(bud.position);
-            scratch.competing.push(i as u32);
+    for (node, range) in scratch.node_bud_start.windows(2).enumerate() {
+        let buds = &scratch.buds[range[0] as usize..range[1] as usize];
+        if let Some(first) = buds.iter().find(|b| b.competes) {
+            scratch.positions.push(first.position);
+            scratch.competing.push(node as u32);
         }
     }
     scratch
@@ -87,18 +89,23 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
         }
         alive_count += 1;
         let mut best: Option<(u32, f32)> = None;
-        let (buds, competing) = (&scratch.buds, &scratch.competing);
+        let (buds, competing, starts) =
+            (&scratch.buds, &scratch.competing, &scratch.node_bud_start);
         scratch
             .bud_grid
-            .for_each_within(point.position, perception, |ci, bud_pos, d2| {
+            .for_each_within(point.position, perception, |ci, node_pos, d2| {
                 if best.is_some_and(|(_, bd)| bd <= d2) {
                     return;
                 }
-                let bi = competing[ci as usize];
-                if (point.position - bud_pos).dot(buds[bi as usize].direction)
-                    >= cos_half * d2.sqrt()
-                {
-                    best = Some((bi, d2));
+                let node = competing[ci as usize] as usize;
+                let towards = point.position - node_pos;
+                let reach = cos_half * d2.sqrt();
+                for bi in starts[node]..starts[node + 1] {
+                    let bud = &buds[bi as usize];
+                    if bud.competes && towards.dot(bud.direction) >= reach {
+                        best = Some((bi, d2));
+                        return;
+                    }
                 }
             });
         if let Some((bi, d2)) = best {
