@@ -54,11 +54,26 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
             .retain(|p| scene.is_free(p.position));
     }
     let points = &tree.environment.attraction.points;
+    // Only nodes near some point can take it or perceive it: the grids hold the nodes inside
+    // the points' bounding box grown by the radius (all of them in autonomous growth, a small
+    // part of the tree under a brush).
+    let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+    for p in points {
+        lo = lo.min(p.position);
+        hi = hi.max(p.position);
+    }
+    let near = |p: Vec3, margin: f32| {
+        p.cmpge(lo - Vec3::splat(margin)).all() && p.cmple(hi + Vec3::splat(margin)).all()
+    };
     // Occupancy: every node (internode end) holds buds or did; its sphere takes points away.
     scratch.positions.clear();
-    scratch
-        .positions
-        .extend(tree.skeleton.internodes.iter().map(|n| n.end));
+    scratch.positions.extend(
+        tree.skeleton
+            .internodes
+            .iter()
+            .map(|n| n.end)
+            .filter(|&e| near(e, r)),
+    );
     scratch.node_grid.rebuild(&scratch.positions, r);
     scratch.point_alive.clear();
     scratch.point_alive.extend(
@@ -74,7 +89,9 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
     scratch.competing.clear();
     for (node, range) in scratch.node_bud_start.windows(2).enumerate() {
         let buds = &scratch.buds[range[0] as usize..range[1] as usize];
-        if let Some(first) = buds.iter().find(|b| b.competes) {
+        if let Some(first) = buds.iter().find(|b| b.competes)
+            && near(first.position, perception)
+        {
             scratch.positions.push(first.position);
             scratch.competing.push(node as u32);
         }
