@@ -35,6 +35,8 @@ struct DesktopApp {
     tree_mesher: crate::tree_model::TreeMesher,
     /// The camera of the 3D view outside AR (framed on the tree when the view opens).
     orbit: Option<crate::ui::orbit::OrbitCamera>,
+    /// Footage frame whose image and occluder the renderer holds.
+    uploaded_frame: Option<usize>,
     started: Instant,
     session_path: PathBuf,
 }
@@ -61,6 +63,7 @@ pub fn run_window(
         meshed_revision: None,
         tree_mesher: Default::default(),
         orbit: None,
+        uploaded_frame: None,
         started: Instant::now(),
         session_path,
     };
@@ -130,7 +133,12 @@ impl ApplicationHandler for DesktopApp {
             return;
         }
         match create_gfx(event_loop) {
-            Ok(gfx) => self.gfx = Some(gfx),
+            Ok(gfx) => {
+                // A new renderer holds nothing yet.
+                self.gfx = Some(gfx);
+                self.uploaded_frame = None;
+                self.meshed_revision = None;
+            }
             Err(e) => {
                 self.error = Some(e);
                 event_loop.exit();
@@ -227,15 +235,20 @@ impl DesktopApp {
                 self.player.ui.budget.meshing_ms = t.elapsed().as_secs_f32() * 1000.0;
                 self.meshed_revision = revision;
             }
-            if let Some(image) = &self.player.image {
-                gfx.renderer.set_camera_image(
-                    &gfx.gpu,
-                    image.as_raw(),
-                    self.player.footage.intrinsics,
-                );
+            // The footage image and the occluder change with the shown frame, not per redraw.
+            if self.uploaded_frame != Some(self.player.frame) {
+                if let Some(image) = &self.player.image {
+                    gfx.renderer.set_camera_image(
+                        &gfx.gpu,
+                        image.as_raw(),
+                        self.player.footage.intrinsics,
+                    );
+                }
+                if let Some(scene) = self.player.scene() {
+                    gfx.renderer.set_occluder(&gfx.gpu, &scene.occluder);
+                }
+                self.uploaded_frame = Some(self.player.frame);
             }
-            gfx.renderer
-                .set_occluder(&gfx.gpu, &self.player.scene.occluder);
             let mut view = FrameView::augmented(camera, self.player.ground());
             view.debug.depth_wireframe = self.player.ui.show_debug;
             view.debug.brush = self.player.brush_sphere();

@@ -25,8 +25,6 @@ pub struct Player {
     pub session: Session,
     pub frame: usize,
     pub image: Option<RgbaImage>,
-    /// Tracking, ground plane and depth mesh of the frame shown.
-    pub scene: SceneFrame,
     tracker: SceneTracker,
     last_tick_s: Option<f64>,
     frame_clock_s: f64,
@@ -48,7 +46,6 @@ impl Player {
             ui,
             frame: 0,
             image: None,
-            scene: SceneFrame::default(),
             tracker,
             last_tick_s: None,
             frame_clock_s: 0.0,
@@ -57,13 +54,18 @@ impl Player {
 
     /// The tracked camera of the current frame.
     pub fn camera(&self) -> Option<ViewCamera> {
-        let m = self.scene.world_from_camera?;
+        let m = self.scene()?.world_from_camera?;
         Some(ViewCamera::new(self.footage.intrinsics, m))
     }
 
     /// The ground plane once the tracker found it (the coaching overlay shows until then).
     pub fn ground(&self) -> Option<GroundPlane> {
-        self.scene.ground
+        self.scene()?.ground
+    }
+
+    /// Tracking, ground plane and depth mesh of the frame shown (None before it is tracked).
+    pub fn scene(&self) -> Option<&SceneFrame> {
+        self.tracker.get(self.frame)
     }
 
     /// The brush sphere at the finger while painting.
@@ -89,12 +91,12 @@ impl Player {
         self.frame = index;
         self.ui.frame = index;
         self.image = Some(self.footage.load_rgba(index)?);
-        self.scene = self.tracker.frame(index)?.clone();
+        let scene = self.tracker.frame(index)?;
         // The frame's own tracking time (frames are tracked once; seeking ahead tracks the ones
         // in between first).
-        self.ui.budget.tracking_ms = self.scene.tracking_ms;
-        self.ui.ground_found = self.scene.ground.is_some();
-        self.session.push_frame(&self.footage, index, &self.scene);
+        self.ui.budget.tracking_ms = scene.tracking_ms;
+        self.ui.ground_found = scene.ground.is_some();
+        self.session.push_frame(&self.footage, index, scene);
         let time_s = self.footage.frames[index].time_s;
         let started = std::time::Instant::now();
         self.design

@@ -117,6 +117,11 @@ mod desktop {
             })
         }
 
+        /// The scene at footage frame `index` if it has been tracked already.
+        pub fn get(&self, index: usize) -> Option<&SceneFrame> {
+            self.frames.get(index)
+        }
+
         /// The scene at footage frame `index`, tracking the frames up to it first if needed.
         pub fn frame(&mut self, index: usize) -> anyhow::Result<&SceneFrame> {
             let index = index.min(self.num_frames.saturating_sub(1));
@@ -223,6 +228,10 @@ impl SceneTracker {
             "tracking recorded footage ({}) needs the OpenCV tracker, which phone builds leave out",
             root.display()
         )
+    }
+
+    pub fn get(&self, index: usize) -> Option<&SceneFrame> {
+        self.frames.get(index)
     }
 
     pub fn frame(&mut self, index: usize) -> anyhow::Result<&SceneFrame> {

@@ -17,8 +17,8 @@ use std::time::Duration;
 use glam::{DAffine3, Vec2, Vec3};
 use image::RgbaImage;
 use sylva_app::footage::Footage;
-use sylva_app::render::ViewCamera;
 use sylva_app::render::resources::letterbox;
+use sylva_app::render::{Intrinsics, ViewCamera};
 use sylva_app::scene_tracking::SceneTracker;
 use sylva_tracking::linalg::Similarity;
 use sylva_tracking::metrics::{PosePair, align_frames};
@@ -65,7 +65,13 @@ fn start_xvfb() -> (Killed, String) {
 
 /// Runs the app paused at `frame` and takes a screenshot once the window shows that frame of the
 /// footage (the app first tracks the frames before it; on a loaded machine that takes a while).
-fn screenshot(display: &str, frame: usize, dir: &Path, image: &RgbaImage) -> RgbaImage {
+fn screenshot(
+    display: &str,
+    frame: usize,
+    dir: &Path,
+    image: &RgbaImage,
+    k: &Intrinsics,
+) -> RgbaImage {
     let app = Command::new(env!("CARGO_BIN_EXE_sylva"))
         .arg("view")
         .arg(demo())
@@ -82,24 +88,11 @@ fn screenshot(display: &str, frame: usize, dir: &Path, image: &RgbaImage) -> Rgb
     let mut shown = 0.0;
     for _ in 0..SCREENSHOT_TRIES {
         std::thread::sleep(Duration::from_secs(3));
-        let status = Command::new("import")
-            .args(["-display", display, "-window", "root"])
-            .arg(&path)
-            .status()
-            .expect("ImageMagick's import is required for this test");
-        assert!(status.success(), "import failed");
-        let shot = image::open(&path).expect("screenshot").to_rgba8();
-        shown = footage_shown(&shot, image);
+        shown = footage_shown(&grab_screen(display, &path), image, k);
         if shown >= 0.8 {
             // One more frame's worth of time so the tree is drawn over the footage too.
             std::thread::sleep(Duration::from_secs(1));
-            let status = Command::new("import")
-                .args(["-display", display, "-window", "root"])
-                .arg(&path)
-                .status()
-                .expect("import");
-            assert!(status.success(), "import failed");
-            return image::open(&path).expect("screenshot").to_rgba8();
+            return grab_screen(display, &path);
         }
     }
     panic!(
@@ -110,14 +103,24 @@ fn screenshot(display: &str, frame: usize, dir: &Path, image: &RgbaImage) -> Rgb
     );
 }
 
+/// The whole screen of `display`, saved at `path`.
+fn grab_screen(display: &str, path: &Path) -> RgbaImage {
+    let status = Command::new("import")
+        .args(["-display", display, "-window", "root"])
+        .arg(path)
+        .status()
+        .expect("ImageMagick's import is required for this test");
+    assert!(status.success(), "import failed");
+    image::open(path).expect("screenshot").to_rgba8()
+}
+
 /// Screenshot attempts, 3 s apart.
 const SCREENSHOT_TRIES: usize = 20;
 
 /// Fraction of a 12 × 9 grid of view pixels where the screenshot shows the footage image (the
 /// tree covers few of them).
-fn footage_shown(shot: &RgbaImage, image: &RgbaImage) -> f32 {
-    let k = Footage::open(&demo()).expect("demo").intrinsics;
-    let region = letterbox(WINDOW, &k);
+fn footage_shown(shot: &RgbaImage, image: &RgbaImage, k: &Intrinsics) -> f32 {
+    let region = letterbox(WINDOW, k);
     let mut same = 0;
     for j in 0..9 {
         for i in 0..12 {
@@ -247,7 +250,7 @@ fn under_xvfb_the_window_shows_a_tree_that_stays_on_the_ground_as_the_camera_mov
     let mut eyes = Vec::new();
     for frame in [60, 200] {
         let image = footage.load_rgba(frame).expect("frame image");
-        let shot = screenshot(&display, frame, &dir, &image);
+        let shot = screenshot(&display, frame, &dir, &image, &footage.intrinsics);
         let pose = footage.frames[frame]
             .world_from_camera
             .expect("ground truth pose");
