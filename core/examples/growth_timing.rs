@@ -6,25 +6,14 @@
 
 use std::time::Instant;
 
-use glam::Vec3;
-use sylva_core::Tree;
-use sylva_core::growth::StepOptions;
-use sylva_core::rng::Rng;
-use sylva_core::species::Species;
+#[path = "../benches/common/growth_trees.rs"]
+mod growth_trees;
+use growth_trees::{brush_iteration, brush_points, grow_to_with, next_brush_tree};
 
 /// Nanoseconds this thread has run on a CPU; `None` off Linux.
 fn thread_cpu_ns() -> Option<u64> {
     let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
     text.split_whitespace().next()?.parse().ok()
-}
-
-/// The benchmark species (see `benches/growth.rs`).
-fn bench_species() -> Species {
-    let mut s = Species::by_name("maple").expect("maple preset");
-    s.internode_length_m = 0.04;
-    s.max_shoot_internodes = 12.0;
-    s.shoot_length_halving_age_years = 0.0;
-    s
 }
 
 fn cpu_ms(start: Option<u64>) -> f64 {
@@ -44,14 +33,9 @@ fn main() {
         if target > max {
             break;
         }
-        let mut tree = Tree::new(bench_species(), 7);
         let (wall, cpu) = (Instant::now(), thread_cpu_ns());
-        while tree.skeleton.len() < target && tree.iteration < 400 {
-            let (w, c) = (Instant::now(), thread_cpu_ns());
-            let stats = tree.step(StepOptions {
-                autonomous: true,
-                scene: None,
-            });
+        let (mut w, mut c) = (Instant::now(), thread_cpu_ns());
+        let tree = grow_to_with(target, |tree, stats| {
             if verbose {
                 println!(
                     "  it {:3}: {:7} internodes, {:6} buds, {:7} points, {:8.2} ms wall {:8.2} ms cpu",
@@ -63,7 +47,8 @@ fn main() {
                     cpu_ms(c)
                 );
             }
-        }
+            (w, c) = (Instant::now(), thread_cpu_ns());
+        });
         println!(
             "grow to {:>6} internodes ({} reached in {} iterations): {:8.1} ms wall, {:8.1} ms cpu",
             target,
@@ -73,46 +58,19 @@ fn main() {
             cpu_ms(cpu)
         );
     }
-    let mut tree = Tree::new(bench_species(), 7);
-    while tree.skeleton.len() < 20_000 {
-        tree.step(StepOptions {
-            autonomous: true,
-            scene: None,
-        });
-    }
-    let top = tree.metrics().height_m;
-    let mut rng = Rng::new(11);
-    let centre = Vec3::new(0.0, top + 0.2, 0.0);
-    let points: Vec<Vec3> = (0..300)
-        .map(|_| centre + rng.in_unit_ball() * 0.4)
-        .collect();
+    let tree = grow_to_with(20_000, |_, _| {});
+    let points = brush_points(&tree);
     let (mut best_wall, mut best_cpu) = (f64::INFINITY, f64::INFINITY);
-    let repeats: usize = std::env::var("SYLVA_BRUSH_REPEATS")
+    let repeats: u64 = std::env::var("SYLVA_BRUSH_REPEATS")
         .ok()
         .and_then(|v| v.parse().ok())
         .unwrap_or(20);
-    // As in the app and the criterion bench: the tree steps with warm working memory; it is
-    // restored to the 20k tree every 8 steps (untimed).
+    // As in the criterion bench: warm working memory, the 20k tree restored now and then.
     let mut t = tree.clone();
     for i in 0..repeats {
-        if i % 8 == 0 {
-            t = tree.clone();
-            for p in &points {
-                t.environment.attraction.add_persistent(*p);
-            }
-            t.step(StepOptions {
-                autonomous: false,
-                scene: None,
-            });
-        }
-        for p in &points {
-            t.environment.attraction.add_persistent(*p);
-        }
+        next_brush_tree(i, &mut t, &tree, &points);
         let (w, c) = (Instant::now(), thread_cpu_ns());
-        t.step(StepOptions {
-            autonomous: false,
-            scene: None,
-        });
+        brush_iteration(&mut t);
         best_wall = best_wall.min(w.elapsed().as_secs_f64() * 1e3);
         best_cpu = best_cpu.min(cpu_ms(c));
     }
