@@ -216,6 +216,23 @@ pub struct DesignState {
     grow_debt: f32,
 }
 
+/// Grows `tree` autonomously to iteration `target` (keeping each iteration in `timeline`), or
+/// ungrows it to the kept iteration `target`.
+fn move_to_iteration(
+    tree: &mut Tree,
+    timeline: &mut Timeline,
+    target: u32,
+) -> Result<(), sylva_core::edit::EditError> {
+    if target < tree.iteration {
+        return timeline.go_to(tree, target);
+    }
+    while tree.iteration < target {
+        tree.grow(1, None);
+        timeline.keep(tree);
+    }
+    Ok(())
+}
+
 /// Autonomous iterations of the sapling a design starts from: a trunk with a few laterals to
 /// brush from.
 pub const PLANTED_ITERATIONS: u32 = 1;
@@ -359,21 +376,11 @@ impl DesignState {
             return;
         }
         let target = self.tree.species.iterations_for_years(years.max(0.0));
-        if target > self.tree.iteration {
-            while self.tree.iteration < target {
-                self.tree.grow(1, None);
-                self.timeline.keep(&self.tree);
-            }
-        } else if target < self.tree.iteration {
-            let earliest = self.timeline.range().map_or(target, |(first, _)| first);
-            if self
-                .timeline
-                .go_to(&mut self.tree, target.max(earliest))
-                .is_err()
-            {
-                return;
-            }
-        } else {
+        let earliest = self.timeline.range().map_or(target, |(first, _)| first);
+        let target = target.max(earliest);
+        if target == self.tree.iteration
+            || move_to_iteration(&mut self.tree, &mut self.timeline, target).is_err()
+        {
             return;
         }
         self.brush = None;
@@ -384,28 +391,19 @@ impl DesignState {
 
     /// Autonomous growth (positive) or ungrowing to an earlier kept iteration (negative).
     fn grow_whole_tree(&mut self, iterations: i32) {
-        let result = if iterations >= 0 {
-            let n = iterations as u32;
-            let timeline = &mut self.timeline;
-            self.history
-                .perform(OperationKind::Grow, &mut self.tree, |tree| {
-                    for _ in 0..n {
-                        tree.grow(1, None);
-                        timeline.keep(tree);
-                    }
-                    Ok(())
-                })
+        let target = if iterations >= 0 {
+            self.tree.iteration.saturating_add(iterations as u32)
         } else {
-            let target = self
-                .tree
+            self.tree
                 .iteration
-                .saturating_sub(iterations.unsigned_abs());
-            let timeline = &self.timeline;
-            self.history
-                .perform(OperationKind::Grow, &mut self.tree, |tree| {
-                    timeline.go_to(tree, target)
-                })
+                .saturating_sub(iterations.unsigned_abs())
         };
+        let timeline = &mut self.timeline;
+        let result = self
+            .history
+            .perform(OperationKind::Grow, &mut self.tree, |tree| {
+                move_to_iteration(tree, timeline, target)
+            });
         if result.is_ok() {
             self.changed();
         }
