@@ -198,20 +198,19 @@ impl DesktopApp {
         if self.player.ui.orbit_view {
             // Outside AR: the tree alone on a lawn, seen by the orbiting camera.
             let tree = &self.player.design.tree;
-            let orbit = *self.orbit.get_or_insert_with(|| {
-                let (mut min, mut max) = (glam::Vec3::splat(f32::MAX), glam::Vec3::splat(f32::MIN));
-                for n in &tree.skeleton.internodes {
-                    min = min.min(n.start.min(n.end));
-                    max = max.max(n.start.max(n.end));
-                }
-                crate::ui::orbit::OrbitCamera::framing(min, max)
-            });
             if self.meshed_revision != Some(self.player.design.revision) {
                 let t = Instant::now();
                 gfx.renderer.set_tree(&gfx.gpu, self.tree_mesher.mesh(tree));
                 self.player.ui.budget.meshing_ms = t.elapsed().as_secs_f32() * 1000.0;
                 self.meshed_revision = Some(self.player.design.revision);
             }
+            let drawn = self.tree_mesher.current();
+            let orbit = *self.orbit.get_or_insert_with(|| {
+                let (min, max) = drawn
+                    .bounds()
+                    .unwrap_or((glam::Vec3::ZERO, glam::Vec3::ONE));
+                crate::ui::orbit::OrbitCamera::framing(min, max)
+            });
             let camera = orbit.camera(self.player.footage.intrinsics);
             gfx.renderer.render(
                 &gfx.gpu,

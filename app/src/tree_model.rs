@@ -90,6 +90,11 @@ impl TreeMesher {
         lit_into(&self.meshes.leaves, leaf_uv, &mut self.mesh.leaves);
         &self.mesh
     }
+
+    /// The mesh of the last [`Self::mesh`] call (empty before the first).
+    pub fn current(&self) -> &TreeMesh {
+        &self.mesh
+    }
 }
 
 /// Leaf texture coordinates from the core's to the renderer's (see [`draw_mesh`]).
