@@ -17,7 +17,7 @@ pub enum Command {
     Grow(crate::cmd_grow::GrowArgs),
     /// Replays a recorded session headlessly: composited PNG frames and the final tree in --out.
     Replay(crate::cmd_app::ReplayArgs),
-    /// Opens a window on a recorded sequence (or `--camera N`).
+    /// Opens a window on a recorded sequence, a video file or `--camera N`.
     View(crate::cmd_app::ViewArgs),
     /// Tracks a recorded sequence; prints timings and a key=value accuracy line.
     Track(crate::cmd_track::TrackArgs),

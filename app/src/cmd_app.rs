@@ -21,12 +21,20 @@ pub struct ReplayArgs {
 
 #[derive(clap::Args, Debug)]
 pub struct ViewArgs {
-    /// Recorded sequence (TUM layout folder).
+    /// Recorded sequence (TUM layout folder) or a video file (.mp4, .avi, …).
     pub sequence: Option<PathBuf>,
     /// Live camera index instead of a recorded sequence.
-    #[arg(long)]
+    #[arg(long, conflicts_with = "sequence")]
     pub camera: Option<u32>,
-    /// Start at this frame.
+    /// Intrinsics of the camera or video (`camera.txt` format); without it a 60° horizontal
+    /// field of view is assumed.
+    #[arg(long)]
+    pub calibration: Option<PathBuf>,
+    /// Record the camera or video frames shown into this folder (TUM layout) with the session
+    /// (`session.json`), so `sylva view DIR` and `sylva replay DIR/session.json` open it.
+    #[arg(long)]
+    pub record: Option<PathBuf>,
+    /// Start at this frame (recorded sequences).
     #[arg(long, default_value_t = 0)]
     pub frame: usize,
     /// Start paused.
@@ -102,8 +110,7 @@ fn open_window(sequence: &Path, start: WindowStart) -> anyhow::Result<()> {
     let session_path = PathBuf::from("out/last-session.json");
     let footage_ref = std::fs::canonicalize(sequence).unwrap_or_else(|_| sequence.to_owned());
     crate::desktop::run_window(
-        footage,
-        footage_ref,
+        crate::player::Player::new(footage, footage_ref)?,
         session_path,
         start.frame,
         start.paused,
@@ -111,16 +118,61 @@ fn open_window(sequence: &Path, start: WindowStart) -> anyhow::Result<()> {
     )
 }
 
-/// `sylva view SEQUENCE` / `sylva view --camera N`.
-pub fn view(args: ViewArgs) -> anyhow::Result<()> {
-    if let Some(index) = args.camera {
-        bail!(
-            "live camera {index}: capture from a live camera is not wired into this build yet; record a sequence and use `sylva view FOLDER`"
-        );
+/// What `sylva view` plays.
+#[derive(Clone, Debug, PartialEq)]
+pub enum ViewSource {
+    /// A TUM-layout folder.
+    Recorded(PathBuf),
+    /// A live camera by index.
+    Camera(u32),
+    /// A video file.
+    Video(PathBuf),
+}
+
+impl ViewArgs {
+    /// The source these arguments name (the demo without any), checking that the stream-only
+    /// options are given with a stream.
+    pub fn source(&self) -> anyhow::Result<ViewSource> {
+        let source = match (&self.sequence, self.camera) {
+            (_, Some(index)) => ViewSource::Camera(index),
+            // A file, or an image pattern such as `frames/%04d.png` that videoio reads.
+            (Some(path), None) if path.is_file() || path.to_string_lossy().contains('%') => {
+                ViewSource::Video(path.clone())
+            }
+            (Some(path), None) if !path.exists() => bail!(
+                "{} does not exist (expected a sequence folder or a video file)",
+                path.display()
+            ),
+            (Some(path), None) => ViewSource::Recorded(path.clone()),
+            (None, None) => ViewSource::Recorded(demo_sequence()?),
+        };
+        if let ViewSource::Recorded(folder) = &source {
+            let option = match (&self.calibration, &self.record) {
+                (Some(_), _) => Some("--calibration"),
+                (None, Some(_)) => Some("--record"),
+                (None, None) => None,
+            };
+            if let Some(option) = option {
+                bail!(
+                    "{option} applies to a live camera or a video file; {} is a recorded sequence (it has its own camera.txt and is replayable as it is)",
+                    folder.display()
+                );
+            }
+        } else if self.frame != 0 {
+            bail!(
+                "--frame applies to recorded sequences; a camera or video stream starts at its first frame"
+            );
+        }
+        Ok(source)
     }
-    let sequence = match args.sequence {
-        Some(s) => s,
-        None => demo_sequence()?,
+}
+
+/// `sylva view SEQUENCE` / `sylva view VIDEO` / `sylva view --camera N`.
+pub fn view(args: ViewArgs) -> anyhow::Result<()> {
+    let sequence = match args.source()? {
+        ViewSource::Recorded(folder) => folder,
+        ViewSource::Camera(index) => return open_stream(StreamSource::Camera(index), &args),
+        ViewSource::Video(path) => return open_stream(StreamSource::File(path), &args),
     };
     open_window(
         &sequence,
@@ -130,6 +182,54 @@ pub fn view(args: ViewArgs) -> anyhow::Result<()> {
             orbit: args.orbit,
         },
     )
+}
+
+#[cfg(not(any(target_os = "android", target_os = "ios")))]
+use crate::live_capture::StreamInput as StreamSource;
+
+/// Phone builds have no videoio streams.
+#[cfg(any(target_os = "android", target_os = "ios"))]
+enum StreamSource {
+    Camera(u32),
+    File(PathBuf),
+}
+
+/// Opens a stream for the player with the options of `args` (calibration, recording); with
+/// `--record DIR` the session is `DIR/session.json` and references `DIR` as its footage.
+#[cfg(not(any(target_os = "android", target_os = "ios")))]
+pub fn stream_player(
+    input: StreamSource,
+    args: &ViewArgs,
+) -> anyhow::Result<(crate::player::Player, PathBuf)> {
+    let stream = crate::live_capture::VideoStream::open(input, args.calibration.as_deref())?;
+    let mut player = crate::player::Player::live(Box::new(stream), args.record.as_deref())?;
+    let session_path = match &args.record {
+        Some(dir) => {
+            // The session lies in its footage folder: the pair can move together.
+            player.session.footage = PathBuf::from(".");
+            dir.join("session.json")
+        }
+        None => PathBuf::from("out/last-session.json"),
+    };
+    Ok((player, session_path))
+}
+
+#[cfg(not(any(target_os = "android", target_os = "ios")))]
+fn open_stream(input: StreamSource, args: &ViewArgs) -> anyhow::Result<()> {
+    let (player, session_path) = stream_player(input, args)?;
+    if let Some(dir) = args.record.as_ref() {
+        eprintln!("recording the frames shown into {}", dir.display());
+    }
+    crate::desktop::run_window(player, session_path, 0, args.paused, args.orbit)
+}
+
+#[cfg(any(target_os = "android", target_os = "ios"))]
+fn open_stream(input: StreamSource, _args: &ViewArgs) -> anyhow::Result<()> {
+    let what = match input {
+        StreamSource::Camera(index) => format!("camera {index}"),
+        StreamSource::File(path) => path.display().to_string(),
+    };
+    bail!("{what}: streams are read with OpenCV's videoio, which phone builds leave out")
 }
 
 /// `sylva replay SESSION --out DIR`.

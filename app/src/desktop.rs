@@ -11,7 +11,6 @@ use winit::event::WindowEvent;
 use winit::event_loop::{ActiveEventLoop, EventLoop};
 use winit::window::{Window, WindowId};
 
-use crate::footage::Footage;
 use crate::player::Player;
 use crate::render::resources::letterbox;
 use crate::render::{FrameView, Gpu, Renderer};
@@ -41,10 +40,10 @@ struct DesktopApp {
     session_path: PathBuf,
 }
 
-/// Opens a window playing `footage`; returns an error when no window can be created.
+/// Opens a window on `player` (recorded footage or a stream); returns an error when no window
+/// can be created.
 pub fn run_window(
-    footage: Footage,
-    footage_ref: PathBuf,
+    mut player: Player,
     session_path: PathBuf,
     first_frame: usize,
     paused: bool,
@@ -52,7 +51,6 @@ pub fn run_window(
 ) -> anyhow::Result<()> {
     let event_loop = EventLoop::new().context("cannot connect to a display")?;
     event_loop.set_control_flow(winit::event_loop::ControlFlow::Poll);
-    let mut player = Player::new(footage, footage_ref)?;
     player.frame = first_frame.min(player.footage.len().saturating_sub(1));
     player.ui.orbit_view = orbit_view;
     player.ui.playing = !paused;
@@ -72,6 +70,11 @@ pub fn run_window(
         .context("window event loop failed")?;
     if let Some(error) = app.error {
         return Err(error);
+    }
+    app.player.finish_recording()?;
+    if !app.player.session_replayable() {
+        println!("live session not saved (pass --record DIR to make it replayable)");
+        return Ok(());
     }
     app.player.session.save(&app.session_path)?;
     println!("session recorded to {}", app.session_path.display());

@@ -10,6 +10,9 @@ pub mod cmd_track;
 pub mod demo_script;
 pub mod desktop;
 pub mod footage;
+pub mod live;
+#[cfg(not(any(target_os = "android", target_os = "ios")))]
+pub mod live_capture;
 pub mod player;
 pub mod render;
 pub mod scene_tracking;

@@ -4,8 +4,10 @@
 //!
 //! The tracker is causal: frame k is tracked after frames 0..k. Each frame is tracked once, in
 //! order, and its result kept, so looping playback, seeking back and replays read the cache and
-//! seeking forward tracks the frames in between. World: metres, Y up, origin on the ground plane
-//! (fixed once the plane is found, so a planted tree never moves).
+//! seeking forward tracks the frames in between. Streams (a live camera, a video file:
+//! [`crate::live`]) feed the same `FrameTracker` each frame as it arrives, keeping no cache.
+//! World: metres, Y up, origin on the ground plane (fixed once the plane is found, so a planted
+//! tree never moves).
 
 use std::path::Path;
 
@@ -74,9 +76,11 @@ impl SceneMesher {
 mod desktop {
     use super::*;
     use anyhow::Context;
-    use glam::{DMat4, Vec2, Vec3};
+    use glam::{DMat4, DVec3, Vec2, Vec3};
     use sylva_tracking::sequence::FileListSource;
-    use sylva_tracking::{FrameSource, SourceEvent, Tracker, TrackerConfig, TumSequence};
+    use sylva_tracking::{
+        Camera, Frame, FrameSource, SourceEvent, Tracker, TrackerConfig, TumSequence,
+    };
 
     /// Plane `normal · p = offset` of the tracker as the renderer's ground (point, up normal).
     fn ground_from_plane(normal: Vec3, offset: f32) -> GroundPlane {
@@ -86,84 +90,36 @@ mod desktop {
         }
     }
 
-    /// Tracks footage frame by frame and keeps every frame's result.
-    pub struct SceneTracker {
-        sequence: TumSequence,
-        source: FileListSource,
+    /// The tracker with the depth mesher of its points: one frame in, the app's scene out.
+    /// Recorded footage ([`SceneTracker`]) and live streams ([`crate::live_capture`]) share it.
+    pub struct FrameTracker {
         tracker: Tracker,
         mesher: SceneMesher,
         intrinsics: Intrinsics,
-        frames: Vec<SceneFrame>,
-        num_frames: usize,
     }
 
-    impl SceneTracker {
-        /// A tracker over the TUM-layout footage at `root` (its `camera.txt` and `rgb.txt`).
-        pub fn open(root: &Path, intrinsics: Intrinsics) -> anyhow::Result<SceneTracker> {
+    impl FrameTracker {
+        /// A tracker for frames of `camera` (its intrinsics for the renderer: `intrinsics`).
+        pub fn new(camera: Camera, intrinsics: Intrinsics) -> anyhow::Result<FrameTracker> {
             sylva_tracking::cv::configure_single_thread();
-            let sequence = TumSequence::open(root)
-                .with_context(|| format!("cannot open {} for tracking", root.display()))?;
-            let tracker = Tracker::new(sequence.camera, TrackerConfig::default())
-                .with_context(|| format!("cannot start the tracker on {}", root.display()))?;
-            let num_frames = sequence.frames.len();
-            Ok(SceneTracker {
-                source: sequence.source(),
-                sequence,
-                tracker,
+            Ok(FrameTracker {
+                tracker: Tracker::new(camera, TrackerConfig::default())?,
                 mesher: SceneMesher::new(&intrinsics),
                 intrinsics,
-                frames: Vec::with_capacity(num_frames),
-                num_frames,
             })
         }
 
-        /// The scene at footage frame `index` if it has been tracked already.
-        pub fn get(&self, index: usize) -> Option<&SceneFrame> {
-            self.frames.get(index)
-        }
-
-        /// The scene at footage frame `index`, tracking the frames up to it first if needed.
-        pub fn frame(&mut self, index: usize) -> anyhow::Result<&SceneFrame> {
-            let index = index.min(self.num_frames.saturating_sub(1));
-            while self.frames.len() <= index {
-                let Some(event) = self.source.next_event() else {
-                    // Fewer readable frames than listed: the rest have no pose.
-                    self.frames.push(SceneFrame::default());
-                    continue;
-                };
-                match event {
-                    SourceEvent::Frame(frame) => {
-                        let up = self.sequence.up_in_camera_at(frame.timestamp_s);
-                        let started = std::time::Instant::now();
-                        let output = self
-                            .tracker
-                            .track(&frame, up.map(|u| u * 9.81))
-                            .with_context(|| format!("tracking frame {}", frame.index))?;
-                        let mut scene = self.scene_of(&output);
-                        scene.tracking_ms = started.elapsed().as_secs_f32() * 1000.0;
-                        self.push_at(frame.index, scene);
-                    }
-                    SourceEvent::Skipped {
-                        index,
-                        path,
-                        reason,
-                    } => {
-                        eprintln!("warning: skipped frame {}: {reason}", path.display());
-                        self.push_at(index, SceneFrame::default());
-                    }
-                }
-            }
-            Ok(&self.frames[index])
-        }
-
-        /// Stores the result for source frame `index` (frames never come out of order).
-        fn push_at(&mut self, index: usize, scene: SceneFrame) {
-            while self.frames.len() < index {
-                self.frames.push(SceneFrame::default());
-            }
-            if self.frames.len() == index {
-                self.frames.push(scene);
-            }
+        /// Tracks the next frame (frames come in order); `up` is gravity "up" in camera axes
+        /// when an accelerometer measured it.
+        pub fn track(&mut self, frame: &Frame, up: Option<DVec3>) -> anyhow::Result<SceneFrame> {
+            let started = std::time::Instant::now();
+            let output = self
+                .tracker
+                .track(frame, up.map(|u| u * 9.81))
+                .with_context(|| format!("tracking frame {}", frame.index))?;
+            let mut scene = self.scene_of(&output);
+            scene.tracking_ms = started.elapsed().as_secs_f32() * 1000.0;
+            Ok(scene)
         }
 
         /// Pose, plane and depth mesh of one tracker output.
@@ -210,10 +166,80 @@ mod desktop {
             }
         }
     }
+
+    /// Tracks footage frame by frame and keeps every frame's result.
+    pub struct SceneTracker {
+        sequence: TumSequence,
+        source: FileListSource,
+        tracker: FrameTracker,
+        frames: Vec<SceneFrame>,
+        num_frames: usize,
+    }
+
+    impl SceneTracker {
+        /// A tracker over the TUM-layout footage at `root` (its `camera.txt` and `rgb.txt`).
+        pub fn open(root: &Path, intrinsics: Intrinsics) -> anyhow::Result<SceneTracker> {
+            let sequence = TumSequence::open(root)
+                .with_context(|| format!("cannot open {} for tracking", root.display()))?;
+            let tracker = FrameTracker::new(sequence.camera, intrinsics)
+                .with_context(|| format!("cannot start the tracker on {}", root.display()))?;
+            let num_frames = sequence.frames.len();
+            Ok(SceneTracker {
+                source: sequence.source(),
+                sequence,
+                tracker,
+                frames: Vec::with_capacity(num_frames),
+                num_frames,
+            })
+        }
+
+        /// The scene at footage frame `index` if it has been tracked already.
+        pub fn get(&self, index: usize) -> Option<&SceneFrame> {
+            self.frames.get(index)
+        }
+
+        /// The scene at footage frame `index`, tracking the frames up to it first if needed.
+        pub fn frame(&mut self, index: usize) -> anyhow::Result<&SceneFrame> {
+            let index = index.min(self.num_frames.saturating_sub(1));
+            while self.frames.len() <= index {
+                let Some(event) = self.source.next_event() else {
+                    // Fewer readable frames than listed: the rest have no pose.
+                    self.frames.push(SceneFrame::default());
+                    continue;
+                };
+                match event {
+                    SourceEvent::Frame(frame) => {
+                        let up = self.sequence.up_in_camera_at(frame.timestamp_s);
+                        let scene = self.tracker.track(&frame, up)?;
+                        self.push_at(frame.index, scene);
+                    }
+                    SourceEvent::Skipped {
+                        index,
+                        path,
+                        reason,
+                    } => {
+                        eprintln!("warning: skipped frame {}: {reason}", path.display());
+                        self.push_at(index, SceneFrame::default());
+                    }
+                }
+            }
+            Ok(&self.frames[index])
+        }
+
+        /// Stores the result for source frame `index` (frames never come out of order).
+        fn push_at(&mut self, index: usize, scene: SceneFrame) {
+            while self.frames.len() < index {
+                self.frames.push(SceneFrame::default());
+            }
+            if self.frames.len() == index {
+                self.frames.push(scene);
+            }
+        }
+    }
 }
 
 #[cfg(not(any(target_os = "android", target_os = "ios")))]
-pub use desktop::SceneTracker;
+pub use desktop::{FrameTracker, SceneTracker};
 
 /// Phone builds leave the OpenCV tracker out: their poses come from the platform's AR session.
 #[cfg(any(target_os = "android", target_os = "ios"))]

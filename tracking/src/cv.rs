@@ -496,6 +496,84 @@ impl VideoSource {
             frame_rate_hz,
         })
     }
+
+    /// What was opened (`camera N` or the file), for messages.
+    pub fn what(&self) -> &str {
+        &self.what
+    }
+
+    /// Frames per second: the stream's own, else the camera model's, else 30.
+    pub fn frame_rate_hz(&self) -> f64 {
+        self.frame_rate_hz
+    }
+
+    /// The frame size the stream reports, when it reports one.
+    pub fn frame_size(&self) -> Option<(u32, u32)> {
+        let get = |property| self.capture.get(property).unwrap_or(0.0);
+        let (w, h) = (
+            get(videoio::CAP_PROP_FRAME_WIDTH),
+            get(videoio::CAP_PROP_FRAME_HEIGHT),
+        );
+        (w >= 1.0 && h >= 1.0).then_some((w as u32, h as u32))
+    }
+
+    /// Asks a live camera for frames of this size; the camera may pick another (see
+    /// [`Self::frame_size`]).
+    pub fn request_frame_size(&mut self, width: u32, height: u32) {
+        // A camera that cannot change its size keeps its own: not an error here.
+        let _ = self
+            .capture
+            .set(videoio::CAP_PROP_FRAME_WIDTH, f64::from(width));
+        let _ = self
+            .capture
+            .set(videoio::CAP_PROP_FRAME_HEIGHT, f64::from(height));
+    }
+
+    /// Replaces the camera model (intrinsics known only once the stream is open).
+    pub fn set_camera(&mut self, camera: Camera) {
+        self.camera = camera;
+    }
+
+    /// The next frame (grey, for tracking) with its colour image (RGB8, as shown), a skipped
+    /// frame, or None at the end of the stream.
+    pub fn next_color(&mut self) -> Option<(SourceEvent, Option<image::RgbImage>)> {
+        self.read(true)
+    }
+
+    fn read(&mut self, color: bool) -> Option<(SourceEvent, Option<image::RgbImage>)> {
+        let mut bgr = Mat::default();
+        let index = self.index;
+        self.index += 1;
+        let skipped = |what: &str, reason: String| SourceEvent::Skipped {
+            index,
+            path: what.into(),
+            reason,
+        };
+        match self.capture.read(&mut bgr) {
+            Ok(true) if !bgr.empty() => {}
+            Ok(_) => return None,
+            Err(e) => return Some((skipped(&self.what, e.to_string()), None)),
+        }
+        let converted = gray_from_mat(&bgr, &self.camera).and_then(|gray| {
+            let rgb = if color {
+                Some(rgb_from_mat(&bgr)?)
+            } else {
+                None
+            };
+            Ok((gray, rgb))
+        });
+        Some(match converted {
+            Ok((image, rgb)) => (
+                SourceEvent::Frame(Frame {
+                    index,
+                    timestamp_s: index as f64 / self.frame_rate_hz,
+                    image,
+                }),
+                rgb,
+            ),
+            Err(reason) => (skipped(&self.what, reason), None),
+        })
+    }
 }
 
 impl FrameSource for VideoSource {
@@ -504,34 +582,22 @@ impl FrameSource for VideoSource {
     }
 
     fn next_event(&mut self) -> Option<SourceEvent> {
-        let mut bgr = Mat::default();
-        let index = self.index;
-        self.index += 1;
-        match self.capture.read(&mut bgr) {
-            Ok(true) if !bgr.empty() => {}
-            Ok(_) => return None,
-            Err(e) => {
-                return Some(SourceEvent::Skipped {
-                    index,
-                    path: self.what.clone().into(),
-                    reason: e.to_string(),
-                });
-            }
-        }
-        let converted = gray_from_mat(&bgr, &self.camera);
-        Some(match converted {
-            Ok(image) => SourceEvent::Frame(Frame {
-                index,
-                timestamp_s: index as f64 / self.frame_rate_hz,
-                image,
-            }),
-            Err(reason) => SourceEvent::Skipped {
-                index,
-                path: self.what.clone().into(),
-                reason,
-            },
-        })
+        self.read(false).map(|(event, _)| event)
     }
+}
+
+/// A colour frame (BGR or grey) as RGB8.
+fn rgb_from_mat(mat: &Mat) -> std::result::Result<image::RgbImage, String> {
+    let mut rgb = Mat::default();
+    let code = if mat.channels() == 3 {
+        imgproc::COLOR_BGR2RGB
+    } else {
+        imgproc::COLOR_GRAY2RGB
+    };
+    imgproc::cvt_color_def(mat, &mut rgb, code).map_err(|e| e.to_string())?;
+    let (w, h) = (rgb.cols() as u32, rgb.rows() as u32);
+    let bytes = rgb.data_bytes().map_err(|e| e.to_string())?.to_vec();
+    image::RgbImage::from_raw(w, h, bytes).ok_or_else(|| "bad colour frame buffer".into())
 }
 
 fn gray_from_mat(mat: &Mat, camera: &Camera) -> std::result::Result<GrayImage, String> {
