@@ -123,10 +123,15 @@ pub struct FootageRecorder {
 }
 
 impl FootageRecorder {
-    /// Starts a recording in `root` (created; refused if it already holds one).
+    /// Starts a recording in `root` (created; refused if it already holds a recorded frame).
     pub fn create(root: &Path, camera: &Camera) -> anyhow::Result<FootageRecorder> {
         let rgb_list = root.join("rgb.txt");
-        if rgb_list.exists() {
+        // A folder left by a start that failed before its first frame (no window) is reused.
+        let lists_frames = std::fs::read_to_string(&rgb_list).is_ok_and(|text| {
+            text.lines()
+                .any(|l| !l.trim().is_empty() && !l.trim_start().starts_with('#'))
+        });
+        if lists_frames {
             bail!(
                 "{} already holds a recording ({} exists); choose another folder",
                 root.display(),
@@ -262,6 +267,9 @@ mod tests {
             assert_eq!(entry.rgb, root.join(format!("rgb/{i:06}.png")));
         }
         recorder.finish().expect("finish");
+        let empty = dir.path().join("empty");
+        drop(FootageRecorder::create(&empty, &camera).expect("an empty recording"));
+        FootageRecorder::create(&empty, &camera).expect("a recording without frames is reused");
         let footage = crate::footage::Footage::open(&root).expect("reopens");
         assert_eq!(footage.len(), 3);
         assert_eq!(footage.intrinsics, intrinsics_of(&camera));

@@ -178,11 +178,8 @@ impl Drop for VideoStream {
 
 /// The camera model of an opened stream: the calibration (its size must match the frames) or
 /// the default guess.
-fn resolve_camera(source: &mut VideoSource, calibration: Option<Camera>) -> anyhow::Result<Camera> {
+fn resolve_camera(source: &VideoSource, calibration: Option<Camera>) -> anyhow::Result<Camera> {
     let what = source.what().to_owned();
-    if let Some(camera) = calibration {
-        source.request_frame_size(camera.width, camera.height);
-    }
     let Some((width, height)) = source.frame_size() else {
         bail!("{what}: the stream does not report its frame size");
     };
@@ -211,14 +208,19 @@ fn open_source(input: &StreamInput, calibration: Option<Camera>) -> anyhow::Resu
     let mut source = match input {
         StreamInput::Camera(index) => {
             let index = i32::try_from(*index).context("camera index too large")?;
-            VideoSource::open_camera(index, placeholder).with_context(|| {
+            let mut source = VideoSource::open_camera(index, placeholder).with_context(|| {
                 format!("cannot open live camera {index} (is a camera connected at that index?)")
-            })?
+            })?;
+            if let Some(camera) = calibration {
+                // The calibrated size, if the camera offers it (checked below).
+                source.request_frame_size(camera.width, camera.height);
+            }
+            source
         }
         StreamInput::File(path) => VideoSource::open_file(path, placeholder)
             .with_context(|| format!("cannot open the video {}", path.display()))?,
     };
-    let camera = resolve_camera(&mut source, calibration)?;
+    let camera = resolve_camera(&source, calibration)?;
     source.set_camera(camera);
     Ok(source)
 }
@@ -249,7 +251,25 @@ fn capture(input: StreamInput, calibration: Option<Camera>, sender: mpsc::SyncSe
     {
         return;
     }
-    let live_camera = matches!(input, StreamInput::Camera(_));
+    stream_frames(
+        &mut source,
+        &mut tracker,
+        &sender,
+        matches!(input, StreamInput::Camera(_)),
+    );
+}
+
+/// Frames skipped in a row (unreadable, wrong size) after which the stream is given up.
+const MAX_SKIPPED_IN_A_ROW: usize = 30;
+
+/// Reads, tracks and sends frames in order until the stream ends, fails, or the player is gone.
+fn stream_frames(
+    source: &mut VideoSource,
+    tracker: &mut FrameTracker,
+    sender: &mpsc::SyncSender<Message>,
+    live_camera: bool,
+) {
+    let mut skipped_in_a_row = 0;
     while let Some((event, rgb)) = source.next_color() {
         let message = match (event, rgb) {
             (SourceEvent::Frame(frame), Some(rgb)) => match tracker.track(&frame, None) {
@@ -261,22 +281,29 @@ fn capture(input: StreamInput, calibration: Option<Camera>, sender: mpsc::SyncSe
                 Err(e) => Message::Failed(e),
             },
             (SourceEvent::Skipped { index, reason, .. }, _) => {
-                eprintln!(
-                    "warning: {}: skipped frame {index}: {reason}",
+                skipped_in_a_row += 1;
+                if skipped_in_a_row < MAX_SKIPPED_IN_A_ROW {
+                    eprintln!(
+                        "warning: {}: skipped frame {index}: {reason}",
+                        source.what()
+                    );
+                    continue;
+                }
+                Message::Failed(anyhow::anyhow!(
+                    "{}: {skipped_in_a_row} frames in a row could not be read (last: {reason})",
                     source.what()
-                );
-                continue;
+                ))
             }
-            (SourceEvent::Frame(frame), None) => {
-                eprintln!(
-                    "warning: {}: frame {} has no colour image",
-                    source.what(),
-                    frame.index
-                );
-                continue;
-            }
+            (SourceEvent::Frame(frame), None) => Message::Failed(anyhow::anyhow!(
+                "{}: frame {} came without its colour image",
+                source.what(),
+                frame.index
+            )),
         };
         let failed = matches!(message, Message::Failed(_));
+        if !failed {
+            skipped_in_a_row = 0;
+        }
         let delivered = if live_camera && !failed {
             // The player still has the previous frame: this one is tracked, not shown.
             !matches!(
