@@ -3,6 +3,9 @@
 //! per size and per iteration, so the scaling can be read directly.
 //!
 //! `cargo run --release -p sylva-core --example growth_timing [max_internodes]`
+//!
+//! `SYLVA_VERBOSE=1` prints every iteration; `SYLVA_DIGEST=1` prints an FNV-1a digest of each
+//! saved tree (and of the brushed tree), so two builds can be checked to grow the same trees.
 
 use std::time::Instant;
 
@@ -23,12 +26,22 @@ fn cpu_ms(start: Option<u64>) -> f64 {
     }
 }
 
+/// FNV-1a (64 bit) of the tree's saved JSON.
+fn digest(tree: &sylva_core::Tree) -> String {
+    let bytes = tree.to_json_bytes().expect("tree serializes");
+    let hash = bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    });
+    format!("{hash:016x}")
+}
+
 fn main() {
     let max: usize = std::env::args()
         .nth(1)
         .and_then(|a| a.parse().ok())
         .unwrap_or(300_000);
     let verbose = std::env::var_os("SYLVA_VERBOSE").is_some();
+    let digests = std::env::var_os("SYLVA_DIGEST").is_some();
     for target in [10_000usize, 100_000, 300_000] {
         if target > max {
             break;
@@ -38,11 +51,14 @@ fn main() {
         let tree = grow_to_with(target, |tree, stats| {
             if verbose {
                 println!(
-                    "  it {:3}: {:7} internodes, {:6} buds, {:7} points, {:8.2} ms wall {:8.2} ms cpu",
+                    "  it {:3}: {:7} internodes, {:6} buds ({:6} enabled), {:7} points, {:6} new, {:6} shed, {:8.2} ms wall {:8.2} ms cpu",
                     tree.iteration,
                     tree.skeleton.len(),
                     stats.num_buds,
+                    stats.num_enabled_buds,
                     stats.num_points,
+                    stats.num_new_internodes,
+                    stats.num_shed_internodes,
                     w.elapsed().as_secs_f64() * 1e3,
                     cpu_ms(c)
                 );
@@ -57,6 +73,9 @@ fn main() {
             wall.elapsed().as_secs_f64() * 1e3,
             cpu_ms(cpu)
         );
+        if digests {
+            println!("  digest {}", digest(&tree));
+        }
     }
     let tree = grow_to_with(20_000, |_, _| {});
     let points = brush_points(&tree);
@@ -78,4 +97,7 @@ fn main() {
         "brush iteration on {} internodes: best {best_wall:.2} ms wall, {best_cpu:.2} ms cpu",
         tree.skeleton.len()
     );
+    if digests {
+        println!("  digest after {repeats} brush steps {}", digest(&t));
+    }
 }

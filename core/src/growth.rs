@@ -95,8 +95,13 @@ pub(crate) struct Scratch {
     pub node_grid: crate::environment::SpatialGrid,
     pub point_grid: crate::environment::SpatialGrid,
     pub point_alive: Vec<bool>,
-    /// Index in `buds` of each entry of `bud_grid` (the buds competing this iteration).
-    pub competing: Vec<u32>,
+    /// The bud each attraction point feeds and its distance² (colonization).
+    pub point_winner: Vec<(u32, f32)>,
+    /// The competing buds of entry i of `bud_grid` (a node) are
+    /// `competing_buds[competing_start[i]..competing_start[i + 1]]`, as (index in `buds`,
+    /// direction), in bud order: compact, for the hot perception loop.
+    pub competing_start: Vec<u32>,
+    pub competing_buds: Vec<(u32, Vec3)>,
     pub q_main: Vec<f32>,
     pub q_lateral: Vec<f32>,
     pub vigor: Vec<f32>,

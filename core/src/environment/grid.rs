@@ -87,6 +87,15 @@ impl SpatialGrid {
         self.entry_index.is_empty()
     }
 
+    /// Every stored point as (index, position), cell by cell: neighbours in space come close
+    /// together, so queries made in this order reuse cached cells.
+    pub fn entries(&self) -> impl Iterator<Item = (u32, Vec3)> + '_ {
+        self.entry_index
+            .iter()
+            .copied()
+            .zip(self.entry_position.iter().copied())
+    }
+
     fn cell_coord(&self, p: Vec3) -> IVec3 {
         floor_to_ivec3((p - self.origin) * self.inv_cell_size)
             .clamp(IVec3::ZERO, self.dims - IVec3::ONE)
@@ -99,30 +108,135 @@ impl SpatialGrid {
     /// Calls `f(index, position, distance²)` for every stored point within `radius` of `center`,
     /// cell by cell and, within a cell, in input order (deterministic).
     pub fn for_each_within(&self, center: Vec3, radius: f32, mut f: impl FnMut(u32, Vec3, f32)) {
-        self.scan(center, radius, |i, p, d2| {
-            f(i, p, d2);
+        self.scan_box(center, radius, |slot, p, d2| {
+            f(self.entry_index[slot], p, d2);
             false
         });
     }
 
     /// True when some stored point lies within `radius` of `center` (stops at the first).
     pub fn any_within(&self, center: Vec3, radius: f32) -> bool {
-        self.scan(center, radius, |_, _, _| true)
+        let mut found = false;
+        self.scan_box(center, radius, |_, _, _| {
+            found = true;
+            true
+        });
+        found
     }
 
-    /// Visits the points within `radius` until `f` returns true; returns whether it did.
-    fn scan(&self, center: Vec3, radius: f32, mut f: impl FnMut(u32, Vec3, f32) -> bool) -> bool {
-        if self.entry_index.is_empty() {
-            return false;
+    /// The nearest stored point within `radius` of `center` that `accept(index, position,
+    /// distance²)` takes (it returns what to report), with its distance². Ties go to the point
+    /// that [`SpatialGrid::for_each_within`] visits first, so the answer is the first strictly
+    /// nearest accepted point of that order. Rows of cells are visited from the centre outwards
+    /// and trimmed to the best distance so far: `accept` is only asked about points that could
+    /// still win.
+    pub fn nearest_accepted<T>(
+        &self,
+        center: Vec3,
+        radius: f32,
+        mut accept: impl FnMut(u32, Vec3, f32) -> Option<T>,
+    ) -> Option<(T, f32)> {
+        let (lo, hi) = self.cell_box(center, radius)?;
+        let mut best: Option<(T, f32, usize)> = None;
+        let mut bound2 = radius * radius;
+        let len = hi - lo + IVec3::ONE;
+        if len.max_element() as usize > MAX_WINDOW {
+            // Slots in increasing order: the first strictly nearest accepted point wins.
+            self.scan_box(center, radius, |slot, p, d2| {
+                if best.as_ref().is_none_or(|(_, bd, _)| d2 < *bd)
+                    && let Some(found) = accept(self.entry_index[slot], p, d2)
+                {
+                    best = Some((found, d2, slot));
+                }
+                false
+            });
+            return best.map(|(found, d2, _)| (found, d2));
         }
-        let r2 = radius * radius;
+        // Squared distance from the centre to the slab of each window cell, per axis.
+        let local = (center - self.origin) * self.inv_cell_size;
+        let mut slab2 = [[0.0f32; MAX_WINDOW]; 3];
+        for (axis, d2s) in slab2.iter_mut().enumerate() {
+            for (i, d2) in d2s[..len[axis] as usize].iter_mut().enumerate() {
+                *d2 = self.slab_distance2(local[axis], lo[axis] + i as i32);
+            }
+        }
+        let [dx2, dy2, dz2] = &slab2;
+        let (nx, ny, nz) = (len.x as usize, len.y as usize, len.z as usize);
+        let cz = (floor_to_i32(local.z) - lo.z).clamp(0, len.z - 1) as usize;
+        let cy = (floor_to_i32(local.y) - lo.y).clamp(0, len.y - 1) as usize;
+        for z in Outward::new(cz, nz) {
+            if dz2[z] > bound2 {
+                continue;
+            }
+            for y in Outward::new(cy, ny) {
+                let dyz2 = dz2[z] + dy2[y];
+                if dyz2 > bound2 {
+                    continue;
+                }
+                // Trim the row's cells to the sphere of the best distance so far.
+                let (mut x0, mut x1) = (0, nx);
+                while x0 < x1 && dx2[x0] + dyz2 > bound2 {
+                    x0 += 1;
+                }
+                while x1 > x0 && dx2[x1 - 1] + dyz2 > bound2 {
+                    x1 -= 1;
+                }
+                if x0 == x1 {
+                    continue;
+                }
+                let row = self.cell_index(lo + IVec3::new(x0 as i32, y as i32, z as i32));
+                let start = self.cell_start[row] as usize;
+                let end = self.cell_start[row + (x1 - x0)] as usize;
+                for slot in start..end {
+                    let p = self.entry_position[slot];
+                    let d2 = p.distance_squared(center);
+                    let better = match &best {
+                        Some((_, bd, bs)) => d2 < *bd || (d2 == *bd && slot < *bs),
+                        None => d2 <= bound2,
+                    };
+                    if better && let Some(found) = accept(self.entry_index[slot], p, d2) {
+                        best = Some((found, d2, slot));
+                        bound2 = d2;
+                    }
+                }
+            }
+        }
+        best.map(|(found, d2, _)| (found, d2))
+    }
+
+    /// Squared distance (metres², slightly under-estimated so that float rounding never drops a
+    /// cell) from a centre at `local` cells along an axis to the slab of cell `cell`.
+    #[inline]
+    fn slab_distance2(&self, local: f32, cell: i32) -> f32 {
+        let cell = cell as f32;
+        let gap = (cell - local).max(local - (cell + 1.0));
+        let d = (gap - CELL_SLACK).max(0.0) * self.cell_size;
+        d * d
+    }
+
+    /// The cells `lo..=hi` that a query sphere's bounding box overlaps, or `None` when it misses
+    /// the grid.
+    #[inline]
+    fn cell_box(&self, center: Vec3, radius: f32) -> Option<(IVec3, IVec3)> {
+        if self.entry_index.is_empty() {
+            return None;
+        }
         let lo = floor_to_ivec3((center - Vec3::splat(radius) - self.origin) * self.inv_cell_size);
         let hi = floor_to_ivec3((center + Vec3::splat(radius) - self.origin) * self.inv_cell_size);
         if hi.cmplt(IVec3::ZERO).any() || lo.cmpge(self.dims).any() {
-            return false;
+            return None;
         }
-        let lo = lo.max(IVec3::ZERO);
-        let hi = hi.min(self.dims - IVec3::ONE);
+        Some((lo.max(IVec3::ZERO), hi.min(self.dims - IVec3::ONE)))
+    }
+
+    /// Visits the points within `radius` cell by cell (z, then y, then x: increasing slots) until
+    /// `f(slot, position, distance²)` returns true.
+    #[inline]
+    fn scan_box(&self, center: Vec3, radius: f32, mut f: impl FnMut(usize, Vec3, f32) -> bool) {
+        let Some((lo, hi)) = self.cell_box(center, radius) else {
+            return;
+        };
+        let r2 = radius * radius;
         for z in lo.z..=hi.z {
             for y in lo.y..=hi.y {
                 let row = self.cell_index(IVec3::new(lo.x, y, z));
@@ -132,13 +246,58 @@ impl SpatialGrid {
                 for slot in start..end {
                     let p = self.entry_position[slot];
                     let d2 = p.distance_squared(center);
-                    if d2 <= r2 && f(self.entry_index[slot], p, d2) {
-                        return true;
+                    if d2 <= r2 && f(slot, p, d2) {
+                        return;
                     }
                 }
             }
         }
-        false
+    }
+}
+
+/// Slack in cells taken off every slab distance so that float rounding in cell assignment and
+/// distances never drops a cell holding a point within the radius.
+const CELL_SLACK: f32 = 1e-3;
+
+/// Most cells per axis of a nearest-point window that is trimmed to its sphere (growth's span
+/// 4 or 5); wider ones are scanned whole.
+const MAX_WINDOW: usize = 8;
+
+/// Cells `0..len` from `center` outwards: center, center + 1, center − 1, center + 2, …
+struct Outward {
+    center: usize,
+    len: usize,
+    step: usize,
+}
+
+impl Outward {
+    fn new(center: usize, len: usize) -> Outward {
+        Outward {
+            center,
+            len,
+            step: 0,
+        }
+    }
+}
+
+impl Iterator for Outward {
+    type Item = usize;
+
+    #[inline]
+    fn next(&mut self) -> Option<usize> {
+        while self.step < 2 * self.len {
+            let k = self.step;
+            self.step += 1;
+            let cell = if k.is_multiple_of(2) {
+                self.center.checked_add(k / 2)
+            } else {
+                self.center.checked_sub(k / 2 + 1)
+            };
+            if let Some(c) = cell.filter(|&c| c < self.len) {
+                return Some(c);
+            }
+        }
+        None
     }
 }
 
@@ -148,6 +307,13 @@ impl SpatialGrid {
 pub(crate) fn floor_to_ivec3(v: Vec3) -> IVec3 {
     let t = v.as_ivec3();
     t - IVec3::select(v.cmplt(t.as_vec3()), IVec3::ONE, IVec3::ZERO)
+}
+
+/// ⌊x⌋ without a libm call (see [`floor_to_ivec3`]).
+#[inline]
+fn floor_to_i32(x: f32) -> i32 {
+    let t = x as i32;
+    t - i32::from(x < t as f32)
 }
 
 #[cfg(test)]
@@ -172,6 +338,51 @@ mod tests {
                 .collect();
             assert_eq!(found, expected);
         }
+    }
+
+    #[test]
+    fn nearest_accepted_matches_the_first_strictly_nearest_of_a_full_scan() {
+        let mut rng = Rng::new(5);
+        // Points on a lattice (many exact distance ties) plus random ones.
+        let mut points: Vec<Vec3> = (0..1000).map(|_| rng.in_unit_ball() * 3.0).collect();
+        for i in 0..400 {
+            points.push(Vec3::new((i % 8) as f32, (i / 8 % 7) as f32, (i / 56) as f32) * 0.25);
+        }
+        for cell in [0.3, 0.7, 0.05] {
+            let mut grid = SpatialGrid::default();
+            grid.rebuild(&points, cell);
+            for q in 0..300 {
+                let center = if q % 3 == 0 {
+                    Vec3::new((q % 8) as f32, 1.0, (q % 5) as f32) * 0.25 + Vec3::splat(0.125)
+                } else {
+                    rng.in_unit_ball() * 3.5
+                };
+                let radius = rng.range_f32(0.0, 1.5);
+                // Accept every other index: the winner must skip refused nearer points.
+                let accept = |i: u32, _: Vec3, _: f32| i.is_multiple_of(2).then_some(i);
+                let mut expected: Option<(u32, f32)> = None;
+                grid.for_each_within(center, radius, |i, p, d2| {
+                    if expected.is_none_or(|(_, bd)| d2 < bd)
+                        && let Some(found) = accept(i, p, d2)
+                    {
+                        expected = Some((found, d2));
+                    }
+                });
+                assert_eq!(grid.nearest_accepted(center, radius, accept), expected);
+            }
+        }
+    }
+
+    #[test]
+    fn entries_list_every_point_once_grouped_by_cell() {
+        let mut rng = Rng::new(9);
+        let points: Vec<Vec3> = (0..500).map(|_| rng.in_unit_ball() * 2.0).collect();
+        let mut grid = SpatialGrid::default();
+        grid.rebuild(&points, 0.5);
+        let mut seen: Vec<u32> = grid.entries().map(|(i, _)| i).collect();
+        assert!(grid.entries().all(|(i, p)| points[i as usize] == p));
+        seen.sort_unstable();
+        assert_eq!(seen, (0..500).collect::<Vec<u32>>());
     }
 
     #[test]

@@ -13,7 +13,8 @@ use glam::{IVec3, Vec3};
 
 /// Fixed-point scale of shadow values: 1.0 of shadow = 65 536 units.
 const UNITS_PER_SHADOW: f32 = 65_536.0;
-/// Voxels per brick edge (a power of two); bricks are 8³ voxels, x fastest.
+/// Voxels per brick edge (a power of two); bricks are 8³ voxels, x fastest, then z, then y, so
+/// one horizontal layer of a brick (what a pyramid level touches) is one contiguous run.
 const BRICK_SHIFT: i32 = 3;
 const BRICK: i32 = 1 << BRICK_SHIFT;
 const BRICK_VOXELS: usize = (BRICK * BRICK * BRICK) as usize;
@@ -36,7 +37,7 @@ pub struct ShadowGrid {
     /// Index into `values` (in bricks) of each brick cell, or [`NO_BRICK`].
     brick_of: Vec<u32>,
     /// Brick after brick in chunks of [`BRICKS_PER_CHUNK`], each brick 8³ values with x
-    /// fastest, then y, then z.
+    /// fastest, then z, then y.
     chunks: Vec<Box<[i32]>>,
     num_bricks: usize,
 }
@@ -101,7 +102,7 @@ impl ShadowGrid {
             return 0.0;
         }
         let local = v & (BRICK - 1);
-        let i = (local.x + BRICK * (local.y + BRICK * local.z)) as usize;
+        let i = (local.x + BRICK * (local.z + BRICK * local.y)) as usize;
         self.brick_values(brick as usize)[i] as f32 / UNITS_PER_SHADOW
     }
 
@@ -124,24 +125,29 @@ impl ShadowGrid {
     }
 
     /// Adds `delta` to the voxels `lo..=hi` of one horizontal layer (`lo.y == hi.y`), brick by
-    /// brick: each brick the square touches is looked up once, then its rows are contiguous runs.
+    /// brick: each brick the square touches is looked up once, then each of its rows takes one
+    /// fixed 8-wide add of `delta` masked to the square's columns (two SIMD adds, no scalar loop).
     fn add_to_layer(&mut self, lo: IVec3, hi: IVec3, delta: i32) {
         let y = lo.y;
         let (by, local_y) = (y >> BRICK_SHIFT, y & (BRICK - 1));
-        for bz in (lo.z >> BRICK_SHIFT)..=(hi.z >> BRICK_SHIFT) {
-            let z0 = lo.z.max(bz << BRICK_SHIFT);
-            let z1 = hi.z.min((bz << BRICK_SHIFT) + BRICK - 1);
-            for bx in (lo.x >> BRICK_SHIFT)..=(hi.x >> BRICK_SHIFT) {
-                let x0 = lo.x.max(bx << BRICK_SHIFT);
-                let x1 = hi.x.min((bx << BRICK_SHIFT) + BRICK - 1);
+        for bx in (lo.x >> BRICK_SHIFT)..=(hi.x >> BRICK_SHIFT) {
+            let x0 = lo.x.max(bx << BRICK_SHIFT) & (BRICK - 1);
+            let x1 = hi.x.min((bx << BRICK_SHIFT) + BRICK - 1) & (BRICK - 1);
+            let mut lanes = [0i32; BRICK as usize];
+            for (x, lane) in lanes.iter_mut().enumerate() {
+                if (x0..=x1).contains(&(x as i32)) {
+                    *lane = delta;
+                }
+            }
+            for bz in (lo.z >> BRICK_SHIFT)..=(hi.z >> BRICK_SHIFT) {
+                let z0 = lo.z.max(bz << BRICK_SHIFT) & (BRICK - 1);
+                let z1 = hi.z.min((bz << BRICK_SHIFT) + BRICK - 1) & (BRICK - 1);
                 let brick = self.brick_at(IVec3::new(bx, by, bz));
                 let values = self.brick_values_mut(brick);
-                let len = (x1 - x0 + 1) as usize;
                 for z in z0..=z1 {
-                    let base = (BRICK * (local_y + BRICK * (z & (BRICK - 1))) + (x0 & (BRICK - 1)))
-                        as usize;
-                    for value in &mut values[base..base + len] {
-                        *value += delta;
+                    let base = (BRICK * (z + BRICK * local_y)) as usize;
+                    for (value, lane) in values[base..base + BRICK as usize].iter_mut().zip(lanes) {
+                        *value += lane;
                     }
                 }
             }

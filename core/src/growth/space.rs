@@ -16,6 +16,9 @@ use super::{Scratch, StepOptions, Tree};
 use crate::environment::{AttractionPoints, SceneMode};
 use crate::rng::Rng;
 
+/// `Scratch::point_winner` of a point that no bud perceives.
+const NO_WINNER: (u32, f32) = (u32::MAX, 0.0);
+
 /// Cell size of the bud grid relative to the perception radius.
 const PERCEPTION_CELL_FRACTION: f32 = 0.5;
 
@@ -75,71 +78,91 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
             .filter(|&e| near(e, r)),
     );
     scratch.node_grid.rebuild(&scratch.positions, r);
+    // The point grid serves the shoots later (perception, consumption); built now, its cell
+    // order also orders the queries below so that neighbouring queries share cached cells.
+    scratch.positions.clear();
+    scratch.positions.extend(points.iter().map(|p| p.position));
+    scratch.point_grid.rebuild(&scratch.positions, perception);
     scratch.point_alive.clear();
-    scratch.point_alive.extend(
-        points
-            .iter()
-            .map(|p| !scratch.node_grid.any_within(p.position, r)),
-    );
+    scratch.point_alive.resize(points.len(), false);
+    for (pi, position) in scratch.point_grid.entries() {
+        scratch.point_alive[pi as usize] = !scratch.node_grid.any_within(position, r);
+    }
     // Perception: each surviving point feeds its closest perceiving bud. The grid holds the
     // nodes with at least one competing bud (a node's buds share its position, so one distance
     // serves them all; they are tried in bud order, as before); cells of half the perception
     // radius keep the scanned volume near the sphere's.
     scratch.positions.clear();
-    scratch.competing.clear();
-    for (node, range) in scratch.node_bud_start.windows(2).enumerate() {
-        let buds = &scratch.buds[range[0] as usize..range[1] as usize];
+    scratch.competing_start.clear();
+    scratch.competing_buds.clear();
+    for range in scratch.node_bud_start.windows(2) {
+        let range = range[0] as usize..range[1] as usize;
+        let buds = &scratch.buds[range.clone()];
         if let Some(first) = buds.iter().find(|b| b.competes)
             && near(first.position, perception)
         {
             scratch.positions.push(first.position);
-            scratch.competing.push(node as u32);
+            scratch
+                .competing_start
+                .push(scratch.competing_buds.len() as u32);
+            scratch.competing_buds.extend(
+                range
+                    .zip(buds)
+                    .filter(|(_, b)| b.competes)
+                    .map(|(bi, b)| (bi as u32, b.direction)),
+            );
         }
     }
     scratch
+        .competing_start
+        .push(scratch.competing_buds.len() as u32);
+    scratch
         .bud_grid
         .rebuild(&scratch.positions, PERCEPTION_CELL_FRACTION * perception);
+    // Each surviving point's winner (bud, distance²), found in the point grid's cell order, then
+    // summed in point order (the order of the sums fixes their rounding).
+    let (starts, competing) = (&scratch.competing_start, &scratch.competing_buds);
+    scratch.point_winner.clear();
+    scratch.point_winner.resize(points.len(), NO_WINNER);
+    for (pi, position) in scratch.point_grid.entries() {
+        if !scratch.point_alive[pi as usize] {
+            continue;
+        }
+        let best = scratch
+            .bud_grid
+            .nearest_accepted(position, perception, |ci, node_pos, d2| {
+                let towards = position - node_pos;
+                let reach = cos_half * d2.sqrt();
+                let buds =
+                    &competing[starts[ci as usize] as usize..starts[ci as usize + 1] as usize];
+                buds.iter()
+                    .find(|(_, direction)| towards.dot(*direction) >= reach)
+                    .map(|&(bi, _)| bi)
+            });
+        if let Some(winner) = best {
+            scratch.point_winner[pi as usize] = winner;
+        }
+    }
     let mut alive_count = 0;
-    for (point, &alive) in points.iter().zip(&scratch.point_alive) {
-        if !alive {
+    for (pi, point) in points.iter().enumerate() {
+        if !scratch.point_alive[pi] {
             continue;
         }
         alive_count += 1;
-        let mut best: Option<(u32, f32)> = None;
-        let (buds, competing, starts) =
-            (&scratch.buds, &scratch.competing, &scratch.node_bud_start);
-        scratch
-            .bud_grid
-            .for_each_within(point.position, perception, |ci, node_pos, d2| {
-                if best.is_some_and(|(_, bd)| bd <= d2) {
-                    return;
-                }
-                let node = competing[ci as usize] as usize;
-                let towards = point.position - node_pos;
-                let reach = cos_half * d2.sqrt();
-                for bi in starts[node]..starts[node + 1] {
-                    let bud = &buds[bi as usize];
-                    if bud.competes && towards.dot(bud.direction) >= reach {
-                        best = Some((bi, d2));
-                        return;
-                    }
-                }
-            });
-        if let Some((bi, d2)) = best {
-            let bud = &mut scratch.buds[bi as usize];
-            bud.environment_sum += (point.position - bud.position) / d2.sqrt().max(1e-12);
-            bud.num_points += 1;
-            if let Some(t) = point.tropism {
-                bud.tropism_sum += t;
-            }
+        let (bi, d2) = scratch.point_winner[pi];
+        if bi == NO_WINNER.0 {
+            continue;
+        }
+        let bud = &mut scratch.buds[bi as usize];
+        bud.environment_sum += (point.position - bud.position) / d2.sqrt().max(1e-12);
+        bud.num_points += 1;
+        if let Some(t) = point.tropism {
+            bud.tropism_sum += t;
         }
     }
     for bud in &mut scratch.buds {
         bud.enabled = bud.num_points > 0;
     }
-    scratch.positions.clear();
-    scratch.positions.extend(points.iter().map(|p| p.position));
-    scratch.point_grid.rebuild(&scratch.positions, perception);
     alive_count
 }
 
