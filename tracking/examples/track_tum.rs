@@ -1,33 +1,14 @@
 //! Quick runner: `cargo run --release -p sylva-tracking --example track_tum -- SEQUENCE`.
+#[path = "common/cfg.rs"]
+mod cfg;
+
 fn main() {
     let Some(root) = std::env::args().nth(1) else {
         eprintln!("usage: track_tum SEQUENCE");
         std::process::exit(2);
     };
     sylva_tracking::cv::configure_single_thread();
-    let mut config = sylva_tracking::TrackerConfig::default();
-    // Tuning aid: SYLVA_CFG="min_parallax_deg=0.5,outlier_px=4".
-    for pair in std::env::var("SYLVA_CFG")
-        .unwrap_or_default()
-        .split(',')
-        .filter(|p| !p.is_empty())
-    {
-        let (key, value) = pair.split_once('=').expect("key=value");
-        let v: f64 = value.parse().expect("number");
-        match key {
-            "max_tracks" => config.max_tracks = v as usize,
-            "min_corner_distance_px" => config.min_corner_distance_px = v as f32,
-            "max_fb_error_px" => config.max_fb_error_px = v as f32,
-            "outlier_px" => config.outlier_px = v,
-            "huber_px" => config.huber_px = v,
-            "min_parallax_deg" => config.min_parallax_deg = v,
-            "init_min_parallax_deg" => config.init_min_parallax_deg = v,
-            "local_window" => config.local_window = v as usize,
-            "max_local_search" => config.max_local_search = v as usize,
-            "max_keyframe_gap" => config.max_keyframe_gap = v as usize,
-            other => panic!("unknown key {other}"),
-        }
-    }
+    let config = cfg::config_from_env();
     match sylva_tracking::report::run_sequence(
         std::path::Path::new(&root),
         config,
@@ -46,6 +27,10 @@ fn main() {
             }
             if std::env::var_os("SYLVA_ROT").is_some() {
                 rotation_check(&root, &report);
+            }
+            if let Some(path) = std::env::var_os("SYLVA_REPORT") {
+                let json = serde_json::to_string(&report).expect("report serialises");
+                std::fs::write(&path, json).expect("report written");
             }
             println!("{}", report.summary_line());
         }

@@ -75,6 +75,7 @@ fn lk(
     next: &Pyramid,
     from: &[Vec2],
     guess: Option<&[Vec2]>,
+    levels: i32,
 ) -> Result<Vec<Option<Vec2>>> {
     if from.is_empty() {
         return Ok(Vec::new());
@@ -96,7 +97,7 @@ fn lk(
         &mut status,
         &mut err,
         Size::new(LK_WINDOW, LK_WINDOW),
-        LK_LEVELS,
+        levels.clamp(0, LK_LEVELS),
         TermCriteria::new(core::TermCriteria_COUNT + core::TermCriteria_EPS, 20, 0.03)?,
         flags,
         1e-4,
@@ -108,24 +109,37 @@ fn lk(
         .collect())
 }
 
-/// Pyramidal Lucas–Kanade from `prev` to `next` with a forward-backward check: a track survives
-/// when tracking it back lands within `max_fb_error_px` of where it started. `guess` seeds the
-/// forward search (e.g. projections of map points).
+/// How a set of points is followed by [`track_points`].
+#[derive(Clone, Copy, Debug)]
+pub struct LkOptions {
+    /// Pyramid levels above the base searched (coarse to fine); fewer when the guess is good.
+    pub levels: i32,
+    /// Forward-backward check: a track survives when tracking it back lands within this many
+    /// pixels of where it started. None skips the backward pass (half the cost) where another
+    /// test (a reprojection gate) rejects wrong matches.
+    pub max_fb_error_px: Option<f32>,
+}
+
+/// Pyramidal Lucas–Kanade from `prev` to `next`, optionally with a forward-backward check.
+/// `guess` seeds the forward search (e.g. projections of map points).
 pub fn track_points(
     prev: &Pyramid,
     next: &Pyramid,
     from: &[Vec2],
     guess: Option<&[Vec2]>,
-    max_fb_error_px: f32,
+    options: LkOptions,
 ) -> Result<Vec<Option<Vec2>>> {
     if from.is_empty() {
         return Ok(Vec::new());
     }
-    let forward = lk(prev, next, from, guess)?;
+    let forward = lk(prev, next, from, guess, options.levels)?;
+    let Some(max_fb_error_px) = options.max_fb_error_px else {
+        return Ok(forward);
+    };
     let alive: Vec<usize> = (0..from.len()).filter(|&i| forward[i].is_some()).collect();
     let there: Vec<Vec2> = alive.iter().filter_map(|&i| forward[i]).collect();
     let back_guess: Vec<Vec2> = alive.iter().map(|&i| from[i]).collect();
-    let backward = lk(next, prev, &there, Some(&back_guess))?;
+    let backward = lk(next, prev, &there, Some(&back_guess), options.levels)?;
     let mut result = vec![None; from.len()];
     for (k, &i) in alive.iter().enumerate() {
         if let Some(b) = backward[k]

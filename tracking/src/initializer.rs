@@ -68,7 +68,10 @@ impl Tracker {
             &pyramid,
             &from,
             None,
-            self.config.max_fb_error_px,
+            cv::LkOptions {
+                levels: self.config.lk_levels,
+                max_fb_error_px: Some(self.config.max_fb_error_px),
+            },
         )?;
         for (k, &i) in alive.iter().enumerate() {
             init.current[i] = moved[k].filter(|p| self.camera.contains(p.as_dvec2(), 2.0));

@@ -28,6 +28,8 @@ pub mod world;
 #[cfg(feature = "opencv")]
 pub mod cv;
 #[cfg(feature = "opencv")]
+mod fusion;
+#[cfg(feature = "opencv")]
 mod initializer;
 #[cfg(feature = "opencv")]
 mod mapping;

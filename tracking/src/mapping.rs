@@ -12,6 +12,25 @@ use crate::tracker::{Tracker, TrackerError};
 use glam::{DVec3, Vec2};
 use std::collections::{BTreeMap, HashMap, HashSet};
 
+/// Median depth of the map points a keyframe sees, in its camera (0 when it sees none).
+fn median_depth(map: &crate::map::Map, keyframe: usize) -> f64 {
+    let Some(kf) = map.keyframes.get(keyframe) else {
+        return 0.0;
+    };
+    let mut depths: Vec<f64> = kf
+        .points
+        .iter()
+        .filter_map(|id| map.points.get(id))
+        .map(|p| kf.camera_from_world.transform_point(p.position).z)
+        .filter(|z| *z > 0.0)
+        .collect();
+    if depths.is_empty() {
+        return 0.0;
+    }
+    depths.sort_by(f64::total_cmp);
+    depths[depths.len() / 2]
+}
+
 /// Keyframe pyramids kept for the local-map search.
 const MAX_KEYFRAME_PYRAMIDS: usize = 40;
 
@@ -27,6 +46,9 @@ impl Tracker {
     /// Makes the current frame a keyframe: observations, new points, new corners, bundle
     /// adjustment. The frame's pose may move with the adjustment.
     pub(crate) fn insert_keyframe(&mut self, frame: &Frame, pose: Se3) -> Result<(), TrackerError> {
+        if self.config.adopt_map_points {
+            self.adopt_map_points(&frame.image, &pose)?;
+        }
         let kf = self.map.add_keyframe(frame.index, pose);
         for track in &self.tracks {
             if let Some(id) = track.point {
@@ -70,19 +92,35 @@ impl Tracker {
     fn triangulate_candidates(&mut self, kf: usize, pose: &Se3) {
         let focal = self.camera.focal();
         let min_parallax = self.config.min_parallax_deg.to_radians();
+        let min_baseline = self.config.min_baseline_ratio;
+        let center = pose.inverse().translation;
+        // Whether each origin keyframe is far enough from this one, judged on the baseline over
+        // its median scene depth: the same test for all its candidates, so the points that get
+        // triangulated are not those whose noise happened to inflate their parallax (choosing
+        // per point at the first threshold crossing makes every new point too near, and the map
+        // shrinks keyframe after keyframe).
+        let mut ready: HashMap<usize, bool> = HashMap::new();
         let mut dropped = Vec::new();
         for (i, track) in self.tracks.iter_mut().enumerate() {
             let Some(origin) = track.origin else { continue };
-            let Some(origin_pose) = self
-                .map
-                .keyframes
-                .get(origin.keyframe)
-                .map(|k| k.camera_from_world)
-            else {
+            let Some(origin_kf) = self.map.keyframes.get(origin.keyframe) else {
                 continue;
             };
+            let origin_pose = origin_kf.camera_from_world;
             let n = self.camera.normalized_from_pixel(track.pixel.as_dvec2());
+            if min_baseline > 0.0 {
+                let is_ready = *ready.entry(origin.keyframe).or_insert_with(|| {
+                    let depth = median_depth(&self.map, origin.keyframe);
+                    depth > 0.0 && origin_kf.center().distance(center) >= min_baseline * depth
+                });
+                if !is_ready {
+                    continue;
+                }
+            }
             if parallax_rad(&origin_pose, origin.normalized, pose, n) < min_parallax {
+                if min_baseline > 0.0 {
+                    dropped.push(i);
+                }
                 continue;
             }
             let point = triangulate(&origin_pose, origin.normalized, pose, n).filter(|x| {
@@ -217,7 +255,13 @@ impl Tracker {
                 pyramid,
                 &from,
                 Some(&guess),
-                self.config.max_fb_error_px,
+                cv::LkOptions {
+                    levels: self.config.search_lk_levels,
+                    max_fb_error_px: self
+                        .config
+                        .search_fb_check
+                        .then_some(self.config.max_fb_error_px),
+                },
             )?;
             for ((id, _, projected), pixel) in list.into_iter().zip(found) {
                 if let Some(pixel) = pixel.filter(|p| p.distance(projected) < 6.0) {

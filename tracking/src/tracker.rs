@@ -31,13 +31,28 @@ pub struct TrackerConfig {
     pub min_corner_distance_px: f32,
     /// Forward-backward Lucas–Kanade tolerance, pixels. Default 2.0.
     pub max_fb_error_px: f32,
+    /// Pyramid levels above the base for frame-to-frame tracks. Default 3.
+    pub lk_levels: i32,
+    /// Pyramid levels above the base for the local-map search, seeded at projections through
+    /// the frame's pose (a guess within a few pixels). Default 3.
+    pub search_lk_levels: i32,
+    /// Whether the local-map search checks matches forward-backward; its reprojection gate
+    /// rejects wrong matches either way. Default true.
+    pub search_fb_check: bool,
     /// Reprojection error beyond which a track is an outlier, pixels. Default 4.0.
     pub outlier_px: f64,
     /// Huber threshold δ for pose refinement and bundle adjustment, pixels. Default 1.5.
     pub huber_px: f64,
-    /// Smallest ray angle for triangulating a point, degrees. Default 0.5 (fr1_rpy is
-    /// mostly rotation: waiting for 1° starves the map).
+    /// Smallest ray angle for triangulating a point once its keyframes pass the baseline test,
+    /// degrees: it drops only points too far away to place. Default 0.25.
     pub min_parallax_deg: f64,
+    /// Candidates are triangulated once their origin keyframe's centre is this far from the
+    /// current keyframe's, as a fraction of the origin's median scene depth (0: per-point
+    /// parallax test alone). Default 0.02.
+    pub min_baseline_ratio: f64,
+    /// Whether keyframes attach candidate corners to old map points they re-find (ORB
+    /// descriptors near the points' projections). Default true.
+    pub adopt_map_points: bool,
     /// Median ray angle needed to initialise, degrees. Default 1.0.
     pub init_min_parallax_deg: f64,
     /// Triangulated points needed to initialise. Default 80.
@@ -62,10 +77,15 @@ impl Default for TrackerConfig {
             max_tracks: 300,
             min_corner_distance_px: 14.0,
             max_fb_error_px: 2.0,
+            lk_levels: 3,
+            search_lk_levels: 3,
+            search_fb_check: true,
             outlier_px: 4.0,
             huber_px: 1.5,
-            min_parallax_deg: 0.5,
+            min_parallax_deg: 0.25,
             init_min_parallax_deg: 1.0,
+            min_baseline_ratio: 0.04,
+            adopt_map_points: true,
             init_min_points: 80,
             min_pose_inliers: 12,
             local_window: 8,
@@ -226,7 +246,10 @@ impl Tracker {
             pyramid,
             &from,
             Some(&guesses),
-            self.config.max_fb_error_px,
+            cv::LkOptions {
+                levels: self.config.lk_levels,
+                max_fb_error_px: Some(self.config.max_fb_error_px),
+            },
         )?;
         let mut kept = Vec::with_capacity(self.tracks.len());
         for (track, next) in self.tracks.iter().zip(moved) {
@@ -350,7 +373,17 @@ impl Tracker {
         if described.len() < 30 {
             return Ok(None);
         }
-        let features = self.orb.detect(&frame.image)?;
+        let features: Vec<(Vec2, crate::map::Descriptor)> = {
+            // The map's descriptors sit on Shi–Tomasi corners at full resolution: describe this
+            // frame's corners the same way, so the same corner gives the same descriptor.
+            let corners = cv::detect_corners(&frame.image, 1000, 7.0, &[])?;
+            let described = self.orb.describe(&frame.image, &corners)?;
+            corners
+                .into_iter()
+                .zip(described)
+                .filter_map(|(p, d)| Some((p, d?)))
+                .collect()
+        };
         let mut matches: Vec<(u64, DVec3, Vec2)> = Vec::new();
         for (pixel, descriptor) in &features {
             let (mut best, mut second, mut best_k) = (u32::MAX, u32::MAX, 0);
