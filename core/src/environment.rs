@@ -11,7 +11,7 @@ mod scene;
 mod shadow;
 
 pub use attraction::{AttractionPoint, AttractionPoints};
-pub use grid::SpatialGrid;
+pub use grid::{Candidates, SpatialGrid};
 pub use scene::{BoxScene, HalfSpace, Scene, SceneMode, SphereScene};
 pub use shadow::ShadowGrid;
 

@@ -95,6 +95,8 @@ pub(crate) struct Scratch {
     pub node_grid: crate::environment::SpatialGrid,
     pub point_grid: crate::environment::SpatialGrid,
     pub point_alive: Vec<bool>,
+    /// Competing nodes near one cell of attraction points (colonization).
+    pub candidates: crate::environment::Candidates,
     /// The bud each attraction point feeds and its distance² (colonization).
     pub point_winner: Vec<(u32, f32)>,
     /// The competing buds of entry i of `bud_grid` (a node) are

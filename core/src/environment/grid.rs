@@ -101,6 +101,44 @@ impl SpatialGrid {
             .clamp(IVec3::ZERO, self.dims - IVec3::ONE)
     }
 
+    /// The indices of the stored points, cell by cell (each non-empty cell's in input order).
+    pub fn cells(&self) -> impl Iterator<Item = &[u32]> + '_ {
+        self.cell_start.windows(2).filter_map(|w| {
+            let (start, end) = (w[0] as usize, w[1] as usize);
+            (start < end).then(|| &self.entry_index[start..end])
+        })
+    }
+
+    /// Gathers, in scan order, every stored point in the cells that overlap the box `lo..=hi`
+    /// (a superset of the points within the box) into `out`, replacing its contents.
+    pub fn gather_box(&self, lo: Vec3, hi: Vec3, out: &mut Candidates) {
+        out.clear();
+        if self.entry_index.is_empty() {
+            return;
+        }
+        let lo = floor_to_ivec3((lo - self.origin) * self.inv_cell_size);
+        let hi = floor_to_ivec3((hi - self.origin) * self.inv_cell_size);
+        if hi.cmplt(IVec3::ZERO).any() || lo.cmpge(self.dims).any() {
+            return;
+        }
+        let lo = lo.max(IVec3::ZERO);
+        let hi = hi.min(self.dims - IVec3::ONE);
+        for z in lo.z..=hi.z {
+            for y in lo.y..=hi.y {
+                let row = self.cell_index(IVec3::new(lo.x, y, z));
+                let start = self.cell_start[row] as usize;
+                let end = self.cell_start[row + (hi.x - lo.x) as usize + 1] as usize;
+                for slot in start..end {
+                    let p = self.entry_position[slot];
+                    out.x.push(p.x);
+                    out.y.push(p.y);
+                    out.z.push(p.z);
+                }
+                out.index.extend_from_slice(&self.entry_index[start..end]);
+            }
+        }
+    }
+
     fn cell_index(&self, c: IVec3) -> usize {
         (c.x + self.dims.x * (c.y + self.dims.y * c.z)) as usize
     }
@@ -309,6 +347,92 @@ pub(crate) fn floor_to_ivec3(v: Vec3) -> IVec3 {
     t - IVec3::select(v.cmplt(t.as_vec3()), IVec3::ONE, IVec3::ZERO)
 }
 
+/// Points gathered from a grid in its scan order ([`SpatialGrid::gather_box`]) as parallel
+/// arrays, so that many nearest-point queries around one place scan them linearly.
+#[derive(Clone, Debug, Default)]
+pub struct Candidates {
+    x: Vec<f32>,
+    y: Vec<f32>,
+    z: Vec<f32>,
+    index: Vec<u32>,
+    d2: Vec<f32>,
+}
+
+impl Candidates {
+    fn clear(&mut self) {
+        self.x.clear();
+        self.y.clear();
+        self.z.clear();
+        self.index.clear();
+    }
+
+    pub fn len(&self) -> usize {
+        self.index.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.index.is_empty()
+    }
+
+    /// What [`SpatialGrid::nearest_accepted`] answers for a query whose sphere lies inside the
+    /// gathered box: the nearest accepted point within `radius` of `center`, ties to the first
+    /// in scan order. Distances are computed exactly as the grid computes them.
+    pub fn nearest_accepted<T>(
+        &mut self,
+        center: Vec3,
+        radius: f32,
+        mut accept: impl FnMut(u32, Vec3, f32) -> Option<T>,
+    ) -> Option<(T, f32)> {
+        let r2 = radius * radius;
+        self.d2.clear();
+        self.d2.extend(
+            self.x
+                .iter()
+                .zip(&self.y)
+                .zip(&self.z)
+                .map(|((&x, &y), &z)| {
+                    // (p − c)·(p − c), as glam's `distance_squared` sums it.
+                    let (dx, dy, dz) = (x - center.x, y - center.y, z - center.z);
+                    dx * dx + dy * dy + dz * dz
+                }),
+        );
+        loop {
+            // The smallest distance left, then its first point (ties go to the first).
+            let nearest = min_of(&self.d2);
+            if nearest > r2 || nearest == f32::INFINITY {
+                return None;
+            }
+            let j = self.d2.iter().position(|&d| d == nearest)?;
+            let p = Vec3::new(self.x[j], self.y[j], self.z[j]);
+            if let Some(found) = accept(self.index[j], p, nearest) {
+                return Some((found, nearest));
+            }
+            // Refused: never the nearest again.
+            self.d2[j] = f32::INFINITY;
+        }
+    }
+}
+
+/// The smallest value (∞ for none; NaNs ignored), in eight independent lanes so that it
+/// compiles to packed minimums.
+fn min_of(values: &[f32]) -> f32 {
+    const LANES: usize = 8;
+    let mut lanes = [f32::INFINITY; LANES];
+    let chunks = values.chunks_exact(LANES);
+    let rest = chunks.remainder();
+    for chunk in chunks {
+        for (m, &d) in lanes.iter_mut().zip(chunk) {
+            *m = if d < *m { d } else { *m };
+        }
+    }
+    for (m, &d) in lanes.iter_mut().zip(rest) {
+        *m = if d < *m { d } else { *m };
+    }
+    lanes
+        .iter()
+        .fold(f32::INFINITY, |m, &d| if d < m { d } else { m })
+}
+
 /// ⌊x⌋ without a libm call (see [`floor_to_ivec3`]).
 #[inline]
 fn floor_to_i32(x: f32) -> i32 {
@@ -369,6 +493,42 @@ mod tests {
                     }
                 });
                 assert_eq!(grid.nearest_accepted(center, radius, accept), expected);
+            }
+        }
+    }
+
+    #[test]
+    fn gathered_candidates_answer_nearest_queries_like_the_grid() {
+        let mut rng = Rng::new(13);
+        let mut points: Vec<Vec3> = (0..3000).map(|_| rng.in_unit_ball() * 2.0).collect();
+        for i in 0..300 {
+            points.push(Vec3::new((i % 6) as f32, (i / 6 % 5) as f32, (i / 30) as f32) * 0.2);
+        }
+        let mut grid = SpatialGrid::default();
+        grid.rebuild(&points, 0.2);
+        let mut candidates = Candidates::default();
+        for q in 0..200 {
+            let radius = rng.range_f32(0.05, 0.5);
+            // Every fourth query box starts between lattice points (exact distance ties).
+            let lo = if q % 4 == 0 {
+                Vec3::new((q % 5) as f32, (q % 4) as f32, (q % 7) as f32) * 0.2 + Vec3::splat(0.1)
+            } else {
+                rng.in_unit_ball() * 2.0
+            };
+            let hi = lo + Vec3::splat(rng.range_f32(0.0, 0.4));
+            grid.gather_box(
+                lo - Vec3::splat(radius),
+                hi + Vec3::splat(radius),
+                &mut candidates,
+            );
+            for k in 0..5 {
+                let t = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32());
+                let center = if k == 0 { lo } else { lo + (hi - lo) * t };
+                let accept = |i: u32, _: Vec3, _: f32| (i % 3 != 1).then_some(i);
+                assert_eq!(
+                    candidates.nearest_accepted(center, radius, accept),
+                    grid.nearest_accepted(center, radius, accept),
+                );
             }
         }
     }

@@ -124,23 +124,43 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
     let (starts, competing) = (&scratch.competing_start, &scratch.competing_buds);
     scratch.point_winner.clear();
     scratch.point_winner.resize(points.len(), NO_WINNER);
-    for (pi, position) in scratch.point_grid.entries() {
-        if !scratch.point_alive[pi as usize] {
+    // Cell by cell of the point grid: the competing nodes near the cell's points are gathered
+    // once, then each point scans that short list.
+    for cell in scratch.point_grid.cells() {
+        let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+        for &pi in cell {
+            if scratch.point_alive[pi as usize] {
+                lo = lo.min(points[pi as usize].position);
+                hi = hi.max(points[pi as usize].position);
+            }
+        }
+        if lo.x > hi.x {
             continue;
         }
-        let best = scratch
+        let reach = Vec3::splat(perception);
+        scratch
             .bud_grid
-            .nearest_accepted(position, perception, |ci, node_pos, d2| {
-                let towards = position - node_pos;
-                let reach = cos_half * d2.sqrt();
-                let buds =
-                    &competing[starts[ci as usize] as usize..starts[ci as usize + 1] as usize];
-                buds.iter()
-                    .find(|(_, direction)| towards.dot(*direction) >= reach)
-                    .map(|&(bi, _)| bi)
-            });
-        if let Some(winner) = best {
-            scratch.point_winner[pi as usize] = winner;
+            .gather_box(lo - reach, hi + reach, &mut scratch.candidates);
+        for &pi in cell {
+            if !scratch.point_alive[pi as usize] {
+                continue;
+            }
+            let position = points[pi as usize].position;
+            let best =
+                scratch
+                    .candidates
+                    .nearest_accepted(position, perception, |ci, node_pos, d2| {
+                        let towards = position - node_pos;
+                        let reach = cos_half * d2.sqrt();
+                        let buds = &competing
+                            [starts[ci as usize] as usize..starts[ci as usize + 1] as usize];
+                        buds.iter()
+                            .find(|(_, direction)| towards.dot(*direction) >= reach)
+                            .map(|&(bi, _)| bi)
+                    });
+            if let Some(winner) = best {
+                scratch.point_winner[pi as usize] = winner;
+            }
         }
     }
     let mut alive_count = 0;
