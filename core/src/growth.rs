@@ -235,7 +235,10 @@ impl Tree {
         stats.num_shoots = grown.0;
         stats.num_new_internodes = grown.1;
         if !shed.is_empty() {
-            stats.num_shed_internodes = self.remove_subtrees(&shed);
+            // The shoots grew only from kept nodes: the new ones stay.
+            let mut removed = removed;
+            removed.resize(self.skeleton.len(), false);
+            stats.num_shed_internodes = self.remove_flagged_subtrees(&removed);
         }
         if let Some((scene, SceneMode::PruneToScene)) = options.scene {
             stats.num_pruned_internodes = self.prune_to_scene(scene);
@@ -251,8 +254,14 @@ impl Tree {
     /// Returns how many internodes were removed.
     pub fn remove_subtrees(&mut self, roots: &[NodeId]) -> usize {
         let flags = self.skeleton.subtree_flags(roots);
+        self.remove_flagged_subtrees(&flags)
+    }
+
+    /// [`Tree::remove_subtrees`] given the flags of every internode to remove (closed under
+    /// descendants, one per internode).
+    fn remove_flagged_subtrees(&mut self, flags: &[bool]) -> usize {
         let mut count = 0;
-        for (node, &gone) in self.skeleton.internodes.iter().zip(&flags) {
+        for (node, &gone) in self.skeleton.internodes.iter().zip(flags) {
             if gone {
                 self.environment.shadow.apply_node(node.end, -1);
                 count += 1;
@@ -261,7 +270,7 @@ impl Tree {
         if count == 0 {
             return 0;
         }
-        let remap = self.skeleton.remove_flagged(&flags);
+        let remap = self.skeleton.remove_flagged(flags);
         self.growth_mask = self
             .growth_mask
             .and_then(|m| remap.get(m.index()).copied().flatten());

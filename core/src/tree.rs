@@ -189,24 +189,20 @@ impl Skeleton {
             });
         }
         remap.resize(self.internodes.len(), None);
-        // Compact in place: a kept node only moves towards the front, so the arena is rewritten
-        // in one pass without a second allocation.
-        let mut write = 0;
-        for (read, kept) in remap.iter().enumerate() {
-            if kept.is_none() {
-                continue;
-            }
-            self.internodes.swap(write, read);
-            let node = &mut self.internodes[write];
+        // Compact in place (each kept node moved once, towards the front), then renumber links.
+        let mut read = 0;
+        self.internodes.retain(|_| {
+            read += 1;
+            remap[read - 1].is_some()
+        });
+        for node in &mut self.internodes {
             node.parent = node.parent.and_then(|p| remap[p.index()]);
             node.main_child = node.main_child.and_then(|c| remap[c.index()]);
             node.lateral_children.retain(|c| remap[c.index()].is_some());
             for c in &mut node.lateral_children {
                 *c = remap[c.index()].unwrap_or(*c);
             }
-            write += 1;
         }
-        self.internodes.truncate(write);
         remap
     }
 
