@@ -217,9 +217,7 @@ impl Tree {
         self.iteration += 1;
         let mut stats = IterationStats::default();
         let mut scratch = std::mem::take(&mut self.scratch);
-        buds::expire_old_buds(self);
         buds::collect(self, &mut scratch);
-        light::expose(self, &mut scratch);
         stats.num_points = space::colonize(self, &mut scratch, options);
         light::bud_input(self, &mut scratch);
         let v_max = vigor::distribute(self, &mut scratch);

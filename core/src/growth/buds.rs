@@ -37,28 +37,23 @@ pub(crate) struct BudState {
     pub competes: bool,
 }
 
-/// Kills lateral buds older than the species' bud lifetime (dormant buds that never broke).
-pub(crate) fn expire_old_buds(tree: &mut Tree) {
+/// The iteration before which lateral buds have outlived the species' bud lifetime (dormant
+/// buds that never broke die), if any.
+fn bud_cutoff(tree: &Tree) -> Option<u32> {
     let s = &tree.species;
     if s.bud_lifetime_years <= 0.0 {
-        return;
+        return None;
     }
     let lifetime = (s.bud_lifetime_years / s.years_per_iteration).ceil() as u32;
-    let Some(cutoff) = tree.iteration.checked_sub(lifetime) else {
-        return;
-    };
-    for node in &mut tree.skeleton.internodes {
-        if node.born_iteration < cutoff && node.lateral_buds.iter().any(|b| b.alive) {
-            for bud in &mut node.lateral_buds {
-                bud.alive = false;
-            }
-        }
-    }
+    tree.iteration.checked_sub(lifetime)
 }
 
-/// Fills `scratch.buds` with every living bud, node by node (terminal first), and the mask.
-pub(crate) fn collect(tree: &Tree, scratch: &mut Scratch) {
-    let nodes = &tree.skeleton.internodes;
+/// One pass over the tree: kills lateral buds older than the bud lifetime, fills
+/// `scratch.buds` with every living bud, node by node (terminal first), with the mask, and
+/// sets the light exposure L of every node that has buds (step 1, [`super::light`]).
+pub(crate) fn collect(tree: &mut Tree, scratch: &mut Scratch) {
+    let cutoff = bud_cutoff(tree);
+    let nodes = &mut tree.skeleton.internodes;
     scratch.buds.clear();
     scratch.node_bud_start.clear();
     scratch.in_mask.clear();
@@ -75,8 +70,17 @@ pub(crate) fn collect(tree: &Tree, scratch: &mut Scratch) {
             }
         }
     }
-    for (i, node) in nodes.iter().enumerate() {
-        scratch.node_bud_start.push(scratch.buds.len() as u32);
+    let (species, shadow) = (&tree.species, &tree.environment.shadow);
+    for (i, node) in nodes.iter_mut().enumerate() {
+        if cutoff.is_some_and(|c| node.born_iteration < c)
+            && node.lateral_buds.iter().any(|b| b.alive)
+        {
+            for bud in &mut node.lateral_buds {
+                bud.alive = false;
+            }
+        }
+        let first = scratch.buds.len();
+        scratch.node_bud_start.push(first as u32);
         let may_grow = scratch.in_mask[i];
         let mut push = |slot: u32, direction: Vec3| {
             scratch.buds.push(BudState {
@@ -103,6 +107,13 @@ pub(crate) fn collect(tree: &Tree, scratch: &mut Scratch) {
         for (slot, bud) in node.lateral_buds.iter().enumerate() {
             if bud.alive {
                 push(slot as u32, bud.direction);
+            }
+        }
+        if scratch.buds.len() > first {
+            let light = super::light::exposure(species, shadow, node.end);
+            node.light_exposure = light;
+            for bud in &mut scratch.buds[first..] {
+                bud.light = light;
             }
         }
     }

@@ -5,25 +5,13 @@ use glam::Vec3;
 
 use super::buds::TERMINAL;
 use super::{Scratch, Tree};
-use crate::species::ControlEllipse;
+use crate::environment::ShadowGrid;
+use crate::species::{ControlEllipse, Species};
 
-/// L = max(C − s + a, 0) for every bud (all buds of a node share its voxel), also stored as the
-/// node's `light_exposure`.
-pub(crate) fn expose(tree: &mut Tree, scratch: &mut Scratch) {
-    let s = &tree.species;
-    let shadow = &tree.environment.shadow;
-    let nodes = &mut tree.skeleton.internodes;
-    for (i, node) in nodes.iter_mut().enumerate() {
-        let range = scratch.node_bud_start[i] as usize..scratch.node_bud_start[i + 1] as usize;
-        if range.is_empty() {
-            continue;
-        }
-        let light = (s.full_exposure - shadow.shadow_at(node.end) + s.shadow_strength).max(0.0);
-        node.light_exposure = light;
-        for bud in &mut scratch.buds[range] {
-            bud.light = light;
-        }
-    }
+/// L = max(C − s + a, 0) at a node (all its buds share its voxel); [`super::buds::collect`]
+/// stores it on every node with buds and on their buds.
+pub(crate) fn exposure(s: &Species, shadow: &ShadowGrid, node_end: Vec3) -> f32 {
+    (s.full_exposure - shadow.shadow_at(node_end) + s.shadow_strength).max(0.0)
 }
 
 /// Q = b·L^κ for enabled buds (0 for the others).
