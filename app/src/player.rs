@@ -99,7 +99,10 @@ impl Player {
             session: Session::new(root, DEFAULT_SEED, params.clone()),
             design: DesignState::new(DEFAULT_SEED, params),
             footage,
-            ui: UiState::default(),
+            ui: UiState {
+                live: true,
+                ..UiState::default()
+            },
             frame: 0,
             image: None,
             scenes: Scenes::Live(Box::new(LiveState {

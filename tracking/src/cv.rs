@@ -289,6 +289,7 @@ pub fn pnp_ransac(
     normalized: &[DVec2],
     guess: Option<Se3>,
     threshold_px: f32,
+    iterations: i32,
 ) -> Result<Option<(Se3, Vec<usize>)>> {
     if world.len() < 6 {
         return Ok(None);
@@ -314,7 +315,7 @@ pub fn pnp_ransac(
         &mut rvec,
         &mut tvec,
         guess.is_some(),
-        100,
+        iterations,
         threshold_px,
         0.99,
         &mut inliers,

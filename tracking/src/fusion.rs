@@ -4,7 +4,7 @@
 //! to the old ones in bundle adjustment, and no duplicate is made at a drifted scale.
 //!
 //! Matching: map points not tracked now are projected through the keyframe's pose; a candidate
-//! takes the point projecting within [`SEARCH_RADIUS_PX`] whose ORB descriptor is nearest, when
+//! takes the point projecting within `TrackerConfig::adopt_radius_px` whose ORB descriptor is nearest, when
 //! that distance is small and clearly better than the next nearest (ratio test).
 
 use crate::map::Descriptor;
@@ -13,8 +13,6 @@ use crate::tracker::{Tracker, TrackerError};
 use glam::Vec2;
 use std::collections::{BTreeMap, HashMap, HashSet};
 
-/// How far from a candidate a map point may project, pixels.
-const SEARCH_RADIUS_PX: f32 = 8.0;
 /// Largest Hamming distance (of 256 bits) for a match.
 const MAX_HAMMING: u32 = 40;
 /// The best match must beat the second best by this ratio.
@@ -79,7 +77,7 @@ impl Tracker {
                         continue;
                     };
                     for (id, projected, d) in list {
-                        if projected.distance(*pixel) > SEARCH_RADIUS_PX {
+                        if projected.distance(*pixel) > self.config.adopt_radius_px {
                             continue;
                         }
                         let distance = crate::cv::hamming(&descriptor, d);

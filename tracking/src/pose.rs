@@ -31,6 +31,15 @@ impl Se3 {
         Self::new(r, -(r * self.translation))
     }
 
+    /// The motion `self` stretched to `k` times its length (rotation angle and translation
+    /// scaled): a per-frame velocity applied over `k` frame intervals.
+    pub fn scaled(&self, k: f64) -> Self {
+        Self::new(
+            DQuat::from_scaled_axis(self.rotation.to_scaled_axis() * k),
+            self.translation * k,
+        )
+    }
+
     /// `self ∘ other`.
     pub fn compose(&self, other: &Self) -> Self {
         Self::new(

@@ -53,6 +53,9 @@ pub struct TrackerConfig {
     /// Whether keyframes attach candidate corners to old map points they re-find (ORB
     /// descriptors near the points' projections). Default true.
     pub adopt_map_points: bool,
+    /// How far from a candidate an old map point may project to be re-found, pixels.
+    /// Default 4.
+    pub adopt_radius_px: f32,
     /// Median ray angle needed to initialise, degrees. Default 1.0.
     pub init_min_parallax_deg: f64,
     /// Triangulated points needed to initialise. Default 80.
@@ -84,8 +87,9 @@ impl Default for TrackerConfig {
             huber_px: 1.5,
             min_parallax_deg: 0.25,
             init_min_parallax_deg: 1.0,
-            min_baseline_ratio: 0.04,
+            min_baseline_ratio: 0.02,
             adopt_map_points: true,
+            adopt_radius_px: 4.0,
             init_min_points: 80,
             min_pose_inliers: 12,
             local_window: 8,
@@ -115,6 +119,10 @@ pub struct Tracker {
     /// `camera_from_world` (map frame) of the previous frame, and the motion since the one before.
     pub(crate) prev_pose: Option<Se3>,
     pub(crate) velocity: Se3,
+    /// Time the velocity spans, and the time of the last frame with a pose, seconds: a frame
+    /// that comes after dropped ones is predicted over the whole gap.
+    pub(crate) velocity_dt_s: f64,
+    pub(crate) last_pose_time_s: Option<f64>,
     pub(crate) keyframe_pyramids: HashMap<usize, Pyramid>,
     pub(crate) init: Option<Initializer>,
     pub(crate) frames_since_keyframe: usize,
@@ -138,6 +146,8 @@ impl Tracker {
             prev_pyramid: None,
             prev_pose: None,
             velocity: Se3::IDENTITY,
+            velocity_dt_s: 0.0,
+            last_pose_time_s: None,
             keyframe_pyramids: HashMap::new(),
             init: None,
             frames_since_keyframe: 0,
@@ -188,6 +198,9 @@ impl Tracker {
             }
             TrackingState::Initializing => {
                 let pose = self.continue_initializing(frame, pyramid)?;
+                if pose.is_some() {
+                    self.last_pose_time_s = Some(frame.timestamp_s);
+                }
                 return Ok(self.output(frame, pose));
             }
             _ if blank => None,
@@ -199,7 +212,10 @@ impl Tracker {
                 self.state = TrackingState::Ok;
                 if let Some(prev) = self.prev_pose {
                     self.velocity = pose.compose(&prev.inverse());
+                    self.velocity_dt_s =
+                        self.last_pose_time_s.map_or(0.0, |t| frame.timestamp_s - t);
                 }
+                self.last_pose_time_s = Some(frame.timestamp_s);
                 self.prev_pose = Some(pose);
                 self.prev_pyramid = Some(pyramid);
                 self.frames_since_keyframe += 1;
@@ -234,7 +250,18 @@ impl Tracker {
         else {
             return self.relocalise(frame);
         };
-        let predicted = self.velocity.compose(&prev_pose);
+        // Frames dropped since the last pose (a gap of at least one and a half frame intervals):
+        // the constant-velocity prediction spans the whole gap.
+        let gap = match self.last_pose_time_s {
+            Some(t) if self.velocity_dt_s > 1e-6 => (frame.timestamp_s - t) / self.velocity_dt_s,
+            _ => 1.0,
+        };
+        let velocity = if gap >= 1.5 {
+            self.velocity.scaled(gap.min(10.0))
+        } else {
+            self.velocity
+        };
+        let predicted = velocity.compose(&prev_pose);
         let guesses: Vec<Vec2> = self
             .tracks
             .iter()
@@ -335,6 +362,7 @@ impl Tracker {
                 &image,
                 Some(start),
                 self.config.outlier_px as f32,
+                100,
             )? {
                 Some((found, _)) => pose = refine_pose(found, &world, &image, &self.ba_config(10)),
                 None => return Ok(None),
@@ -404,7 +432,9 @@ impl Tracker {
             .iter()
             .map(|m| normalized(&self.camera, m.2))
             .collect();
-        let found = cv::pnp_ransac(&self.camera, &world, &image, None, 4.0)?;
+        // Descriptor matches of a blurred or changed view hold many wrong ones: sample enough
+        // hypotheses to find the right pose among a third of inliers.
+        let found = cv::pnp_ransac(&self.camera, &world, &image, None, 4.0, 1000)?;
         let Some((pose, inliers)) = found else {
             return Ok(None);
         };

@@ -42,6 +42,8 @@ pub struct UiState {
     pub num_frames: usize,
     /// Set by the seek slider; the caller jumps there.
     pub seek_to: Option<usize>,
+    /// A live stream (camera, video): frames come as they come, there is nothing to seek.
+    pub live: bool,
     pub ground_found: bool,
     pub budget: FrameBudget,
     pub show_debug: bool,
@@ -59,6 +61,7 @@ impl Default for UiState {
             frame: 0,
             num_frames: 0,
             seek_to: None,
+            live: false,
             ground_found: false,
             budget: FrameBudget::default(),
             show_debug: false,
@@ -227,13 +230,17 @@ fn playback_ui(ui: &mut Ui, state: &mut UiState) {
         if ui.button(label).clicked() {
             state.playing = !state.playing;
         }
-        let mut frame = state.frame;
-        let last = state.num_frames.saturating_sub(1);
-        if ui
-            .add(egui::Slider::new(&mut frame, 0..=last).text("Frame"))
-            .changed()
-        {
-            state.seek_to = Some(frame);
+        if state.live {
+            ui.label(format!("Frame {} (live)", state.frame));
+        } else {
+            let mut frame = state.frame;
+            let last = state.num_frames.saturating_sub(1);
+            if ui
+                .add(egui::Slider::new(&mut frame, 0..=last).text("Frame"))
+                .changed()
+            {
+                state.seek_to = Some(frame);
+            }
         }
         ui.checkbox(&mut state.show_debug, "Debug views");
         ui.checkbox(&mut state.orbit_view, "3D view (outside AR)");

@@ -26,6 +26,7 @@ pub fn config_from_env() -> sylva_tracking::TrackerConfig {
             "search_fb_check" => config.search_fb_check = v != 0.0,
             "min_baseline_ratio" => config.min_baseline_ratio = v,
             "adopt_map_points" => config.adopt_map_points = v != 0.0,
+            "adopt_radius_px" => config.adopt_radius_px = v as f32,
             "min_pose_inliers" => config.min_pose_inliers = v as usize,
             "init_min_points" => config.init_min_points = v as usize,
             other => panic!("unknown key {other}"),
