@@ -101,11 +101,17 @@ impl SpatialGrid {
             .clamp(IVec3::ZERO, self.dims - IVec3::ONE)
     }
 
-    /// The indices of the stored points, cell by cell (each non-empty cell's in input order).
-    pub fn cells(&self) -> impl Iterator<Item = &[u32]> + '_ {
+    /// The stored points cell by cell: each non-empty cell's indices and positions (in input
+    /// order).
+    pub fn cells(&self) -> impl Iterator<Item = (&[u32], &[Vec3])> + '_ {
         self.cell_start.windows(2).filter_map(|w| {
             let (start, end) = (w[0] as usize, w[1] as usize);
-            (start < end).then(|| &self.entry_index[start..end])
+            (start < end).then(|| {
+                (
+                    &self.entry_index[start..end],
+                    &self.entry_position[start..end],
+                )
+            })
         })
     }
 

@@ -126,12 +126,12 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
     scratch.point_winner.resize(points.len(), NO_WINNER);
     // Cell by cell of the point grid: the competing nodes near the cell's points are gathered
     // once, then each point scans that short list.
-    for cell in scratch.point_grid.cells() {
+    for (cell, positions) in scratch.point_grid.cells() {
         let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-        for &pi in cell {
+        for (&pi, &position) in cell.iter().zip(positions) {
             if scratch.point_alive[pi as usize] {
-                lo = lo.min(points[pi as usize].position);
-                hi = hi.max(points[pi as usize].position);
+                lo = lo.min(position);
+                hi = hi.max(position);
             }
         }
         if lo.x > hi.x {
@@ -141,11 +141,10 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
         scratch
             .bud_grid
             .gather_box(lo - reach, hi + reach, &mut scratch.candidates);
-        for &pi in cell {
+        for (&pi, &position) in cell.iter().zip(positions) {
             if !scratch.point_alive[pi as usize] {
                 continue;
             }
-            let position = points[pi as usize].position;
             let best =
                 scratch
                     .candidates
