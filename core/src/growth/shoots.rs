@@ -156,11 +156,11 @@ fn grow_shoot(
     let mut heading = bud.direction;
     let mut environment = bud.environment_sum.try_normalize().unwrap_or(heading);
     let mut carried = bud.tropism_sum.try_normalize();
+    // What the tip perceived after the previous internode (none before the first).
+    let mut perceived: Option<(Vec3, Option<Vec3>)> = None;
     for k in 0..n {
         let tip = tree.skeleton.internodes[parent].end;
-        if k > 0
-            && let Some((e, t)) = space::perceive(tree, scratch, tip, heading)
-        {
+        if let Some((e, t)) = perceived.take() {
             environment = e;
             carried = t.or(carried);
         }
@@ -213,7 +213,11 @@ fn grow_shoot(
         tree.environment.shadow.apply_node(end, 1);
         node.light_exposure = tree.ambient_at(end) * tree.species.full_exposure;
         tree.skeleton.internodes.push(node);
-        space::consume(scratch, end, r);
+        if k + 1 < n {
+            perceived = space::consume_and_perceive(tree, scratch, end, r, new_heading);
+        } else {
+            space::consume(scratch, end, r);
+        }
         heading = new_heading;
         parent = id.index();
     }

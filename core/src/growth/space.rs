@@ -209,22 +209,32 @@ fn generate_points(tree: &mut Tree, scratch: &Scratch, r: f32, perception: f32, 
     }
 }
 
-/// Optimal direction E (and carried tropism) for a shoot tip re-perceiving the remaining points.
-pub(crate) fn perceive(
+/// [`consume`] at a new node's end (`tip`), then the optimal direction E (and carried
+/// tropism) that the next internode of its shoot perceives from there, heading along
+/// `heading`: in one scan of the perception sphere, the points visited in the order a separate
+/// consumption and perception would visit them.
+pub(crate) fn consume_and_perceive(
     tree: &Tree,
-    scratch: &Scratch,
+    scratch: &mut Scratch,
     tip: Vec3,
+    r: f32,
     heading: Vec3,
 ) -> Option<(Vec3, Option<Vec3>)> {
     let (_, perception, cos_half) = radii(tree);
+    let consume_r2 = r * r;
     let points = &tree.environment.attraction.points;
+    let alive = &mut scratch.point_alive;
     let mut sum = Vec3::ZERO;
     let mut tropism = Vec3::ZERO;
     let mut count = 0;
     scratch
         .point_grid
         .for_each_within(tip, perception, |pi, p, d2| {
-            if !scratch.point_alive[pi as usize] || d2 <= 0.0 {
+            if d2 <= consume_r2 {
+                alive[pi as usize] = false;
+                return;
+            }
+            if !alive[pi as usize] || d2 <= 0.0 {
                 return;
             }
             let d = d2.sqrt();
