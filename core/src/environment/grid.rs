@@ -168,96 +168,6 @@ impl SpatialGrid {
         found
     }
 
-    /// The nearest stored point within `radius` of `center` that `accept(index, position,
-    /// distance²)` takes (it returns what to report), with its distance². Ties go to the point
-    /// that [`SpatialGrid::for_each_within`] visits first, so the answer is the first strictly
-    /// nearest accepted point of that order. Rows of cells are visited from the centre outwards
-    /// and trimmed to the best distance so far: `accept` is only asked about points that could
-    /// still win.
-    pub fn nearest_accepted<T>(
-        &self,
-        center: Vec3,
-        radius: f32,
-        mut accept: impl FnMut(u32, Vec3, f32) -> Option<T>,
-    ) -> Option<(T, f32)> {
-        let (lo, hi) = self.cell_box(center, radius)?;
-        let mut best: Option<(T, f32, usize)> = None;
-        let mut bound2 = radius * radius;
-        let len = hi - lo + IVec3::ONE;
-        if len.max_element() as usize > MAX_WINDOW {
-            // Slots in increasing order: the first strictly nearest accepted point wins.
-            self.scan_box(center, radius, |slot, p, d2| {
-                if best.as_ref().is_none_or(|(_, bd, _)| d2 < *bd)
-                    && let Some(found) = accept(self.entry_index[slot], p, d2)
-                {
-                    best = Some((found, d2, slot));
-                }
-                false
-            });
-            return best.map(|(found, d2, _)| (found, d2));
-        }
-        // Squared distance from the centre to the slab of each window cell, per axis.
-        let local = (center - self.origin) * self.inv_cell_size;
-        let mut slab2 = [[0.0f32; MAX_WINDOW]; 3];
-        for (axis, d2s) in slab2.iter_mut().enumerate() {
-            for (i, d2) in d2s[..len[axis] as usize].iter_mut().enumerate() {
-                *d2 = self.slab_distance2(local[axis], lo[axis] + i as i32);
-            }
-        }
-        let [dx2, dy2, dz2] = &slab2;
-        let (nx, ny, nz) = (len.x as usize, len.y as usize, len.z as usize);
-        let cz = (floor_to_i32(local.z) - lo.z).clamp(0, len.z - 1) as usize;
-        let cy = (floor_to_i32(local.y) - lo.y).clamp(0, len.y - 1) as usize;
-        for z in Outward::new(cz, nz) {
-            if dz2[z] > bound2 {
-                continue;
-            }
-            for y in Outward::new(cy, ny) {
-                let dyz2 = dz2[z] + dy2[y];
-                if dyz2 > bound2 {
-                    continue;
-                }
-                // Trim the row's cells to the sphere of the best distance so far.
-                let (mut x0, mut x1) = (0, nx);
-                while x0 < x1 && dx2[x0] + dyz2 > bound2 {
-                    x0 += 1;
-                }
-                while x1 > x0 && dx2[x1 - 1] + dyz2 > bound2 {
-                    x1 -= 1;
-                }
-                if x0 == x1 {
-                    continue;
-                }
-                let row = self.cell_index(lo + IVec3::new(x0 as i32, y as i32, z as i32));
-                let start = self.cell_start[row] as usize;
-                let end = self.cell_start[row + (x1 - x0)] as usize;
-                for slot in start..end {
-                    let p = self.entry_position[slot];
-                    let d2 = p.distance_squared(center);
-                    let better = match &best {
-                        Some((_, bd, bs)) => d2 < *bd || (d2 == *bd && slot < *bs),
-                        None => d2 <= bound2,
-                    };
-                    if better && let Some(found) = accept(self.entry_index[slot], p, d2) {
-                        best = Some((found, d2, slot));
-                        bound2 = d2;
-                    }
-                }
-            }
-        }
-        best.map(|(found, d2, _)| (found, d2))
-    }
-
-    /// Squared distance (metres², slightly under-estimated so that float rounding never drops a
-    /// cell) from a centre at `local` cells along an axis to the slab of cell `cell`.
-    #[inline]
-    fn slab_distance2(&self, local: f32, cell: i32) -> f32 {
-        let cell = cell as f32;
-        let gap = (cell - local).max(local - (cell + 1.0));
-        let d = (gap - CELL_SLACK).max(0.0) * self.cell_size;
-        d * d
-    }
-
     /// The cells `lo..=hi` that a query sphere's bounding box overlaps, or `None` when it misses
     /// the grid.
     #[inline]
@@ -299,52 +209,6 @@ impl SpatialGrid {
     }
 }
 
-/// Slack in cells taken off every slab distance so that float rounding in cell assignment and
-/// distances never drops a cell holding a point within the radius.
-const CELL_SLACK: f32 = 1e-3;
-
-/// Most cells per axis of a nearest-point window that is trimmed to its sphere (growth's span
-/// 4 or 5); wider ones are scanned whole.
-const MAX_WINDOW: usize = 8;
-
-/// Cells `0..len` from `center` outwards: center, center + 1, center − 1, center + 2, …
-struct Outward {
-    center: usize,
-    len: usize,
-    step: usize,
-}
-
-impl Outward {
-    fn new(center: usize, len: usize) -> Outward {
-        Outward {
-            center,
-            len,
-            step: 0,
-        }
-    }
-}
-
-impl Iterator for Outward {
-    type Item = usize;
-
-    #[inline]
-    fn next(&mut self) -> Option<usize> {
-        while self.step < 2 * self.len {
-            let k = self.step;
-            self.step += 1;
-            let cell = if k.is_multiple_of(2) {
-                self.center.checked_add(k / 2)
-            } else {
-                self.center.checked_sub(k / 2 + 1)
-            };
-            if let Some(c) = cell.filter(|&c| c < self.len) {
-                return Some(c);
-            }
-        }
-        None
-    }
-}
-
 /// ⌊v⌋ per component without a libm call (x86-64's baseline has no SSE4.1 `roundps`, so
 /// `f32::floor` is a function call in the hot query loops). Saturates like `as`, NaN gives 0.
 #[inline]
@@ -380,9 +244,11 @@ impl Candidates {
         self.index.is_empty()
     }
 
-    /// What [`SpatialGrid::nearest_accepted`] answers for a query whose sphere lies inside the
-    /// gathered box: the nearest accepted point within `radius` of `center`, ties to the first
-    /// in scan order. Distances are computed exactly as the grid computes them.
+    /// For a query whose sphere lies inside the gathered box: the nearest point within `radius`
+    /// of `center` that `accept(index, position, distance²)` takes (it returns what to report),
+    /// with its distance²; among equally near points the first that
+    /// [`SpatialGrid::for_each_within`] visits. Distances are computed exactly as the grid
+    /// computes them.
     pub fn nearest_accepted<T>(
         &mut self,
         center: Vec3,
@@ -439,13 +305,6 @@ fn min_of(values: &[f32]) -> f32 {
         .fold(f32::INFINITY, |m, &d| if d < m { d } else { m })
 }
 
-/// ⌊x⌋ without a libm call (see [`floor_to_ivec3`]).
-#[inline]
-fn floor_to_i32(x: f32) -> i32 {
-    let t = x as i32;
-    t - i32::from(x < t as f32)
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -470,37 +329,22 @@ mod tests {
         }
     }
 
-    #[test]
-    fn nearest_accepted_matches_the_first_strictly_nearest_of_a_full_scan() {
-        let mut rng = Rng::new(5);
-        // Points on a lattice (many exact distance ties) plus random ones.
-        let mut points: Vec<Vec3> = (0..1000).map(|_| rng.in_unit_ball() * 3.0).collect();
-        for i in 0..400 {
-            points.push(Vec3::new((i % 8) as f32, (i / 8 % 7) as f32, (i / 56) as f32) * 0.25);
-        }
-        for cell in [0.3, 0.7, 0.05] {
-            let mut grid = SpatialGrid::default();
-            grid.rebuild(&points, cell);
-            for q in 0..300 {
-                let center = if q % 3 == 0 {
-                    Vec3::new((q % 8) as f32, 1.0, (q % 5) as f32) * 0.25 + Vec3::splat(0.125)
-                } else {
-                    rng.in_unit_ball() * 3.5
-                };
-                let radius = rng.range_f32(0.0, 1.5);
-                // Accept every other index: the winner must skip refused nearer points.
-                let accept = |i: u32, _: Vec3, _: f32| i.is_multiple_of(2).then_some(i);
-                let mut expected: Option<(u32, f32)> = None;
-                grid.for_each_within(center, radius, |i, p, d2| {
-                    if expected.is_none_or(|(_, bd)| d2 < bd)
-                        && let Some(found) = accept(i, p, d2)
-                    {
-                        expected = Some((found, d2));
-                    }
-                });
-                assert_eq!(grid.nearest_accepted(center, radius, accept), expected);
+    /// The first strictly nearest accepted point in the grid's scan order (the reference).
+    fn first_nearest_accepted(
+        grid: &SpatialGrid,
+        center: Vec3,
+        radius: f32,
+        accept: impl Fn(u32, Vec3, f32) -> Option<u32>,
+    ) -> Option<(u32, f32)> {
+        let mut best: Option<(u32, f32)> = None;
+        grid.for_each_within(center, radius, |i, p, d2| {
+            if best.is_none_or(|(_, bd)| d2 < bd)
+                && let Some(found) = accept(i, p, d2)
+            {
+                best = Some((found, d2));
             }
-        }
+        });
+        best
     }
 
     #[test]
@@ -533,7 +377,7 @@ mod tests {
                 let accept = |i: u32, _: Vec3, _: f32| (i % 3 != 1).then_some(i);
                 assert_eq!(
                     candidates.nearest_accepted(center, radius, accept),
-                    grid.nearest_accepted(center, radius, accept),
+                    first_nearest_accepted(&grid, center, radius, accept),
                 );
             }
         }
