@@ -38,6 +38,7 @@ struct DesktopApp {
     uploaded_frame: Option<usize>,
     started: Instant,
     session_path: PathBuf,
+    autosaver: crate::autosave::Autosaver,
 }
 
 /// Opens a window on `player` (recorded footage or a stream); returns an error when no window
@@ -54,6 +55,12 @@ pub fn run_window(
     player.frame = first_frame.min(player.footage.len().saturating_sub(1));
     player.ui.orbit_view = orbit_view;
     player.ui.playing = !paused;
+    let autosaver = crate::autosave::Autosaver::new(
+        &session_path,
+        !player.is_live(),
+        crate::autosave::AUTOSAVE_INTERVAL,
+    );
+    println!("autosaving the tree to {}", autosaver.tree_path().display());
     let mut app = DesktopApp {
         player,
         gfx: None,
@@ -64,13 +71,17 @@ pub fn run_window(
         uploaded_frame: None,
         started: Instant::now(),
         session_path,
+        autosaver,
     };
     event_loop
         .run_app(&mut app)
         .context("window event loop failed")?;
+    // Whatever happened, the tree is kept.
+    let flushed = app.autosaver.flush(&app.player.design, &app.player.session);
     if let Some(error) = app.error {
         return Err(error);
     }
+    flushed?;
     app.player.finish_recording()?;
     if !app.player.session_replayable() {
         println!("live session not saved (pass --record DIR to make it replayable)");
@@ -172,6 +183,12 @@ impl ApplicationHandler for DesktopApp {
     }
 
     fn about_to_wait(&mut self, _event_loop: &ActiveEventLoop) {
+        if let Err(error) =
+            self.autosaver
+                .poll(Instant::now(), &self.player.design, &self.player.session)
+        {
+            eprintln!("warning: {error:#}");
+        }
         if let Some(gfx) = &self.gfx {
             gfx.window.request_redraw();
         }

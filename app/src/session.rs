@@ -142,7 +142,13 @@ impl Session {
         // Compact: a few hundred tracked points per frame make pretty-printing several times
         // larger.
         let json = serde_json::to_string(self)?;
-        std::fs::write(path, json).with_context(|| format!("cannot write {}", path.display()))
+        // Atomic: a temporary file beside `path`, renamed over it, so a crash mid-write leaves
+        // the previous session whole.
+        let mut temp = path.as_os_str().to_owned();
+        temp.push(".tmp");
+        let temp = PathBuf::from(temp);
+        std::fs::write(&temp, json).with_context(|| format!("cannot write {}", temp.display()))?;
+        std::fs::rename(&temp, path).with_context(|| format!("cannot write {}", path.display()))
     }
 }
 
