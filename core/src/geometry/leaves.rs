@@ -17,7 +17,7 @@ use serde::{Deserialize, Serialize};
 use super::petiole::{Attachment, Blade, Petiole};
 use super::{AmbientFn, NodeGeom, TreeMesh, any_perpendicular, hash_unit};
 use crate::rng::Rng;
-use crate::tree::Skeleton;
+use crate::tree::{Internode, Skeleton};
 
 /// The golden angle, radians: the phyllotactic divergence between successive leaves.
 const GOLDEN_ANGLE: f32 = 2.399_963;
@@ -103,10 +103,42 @@ pub fn build_leaves(
     mesh
 }
 
-/// Working memory of [`build_leaves_into`]: the leaf slots.
+/// Working memory of [`build_leaves_into`]: the leaf slots and the spiral.
 #[derive(Default)]
 pub(crate) struct LeafScratch {
     slots: Vec<Attachment>,
+    spiral: Spiral,
+}
+
+/// The phyllotactic spiral: leaf n of a tree (in arena order) turns by n + 1 golden angles, as
+/// a running complex product renormalised at each step. The products depend on each other, so
+/// they are made once and kept: the same for every tree.
+#[derive(Default)]
+struct Spiral {
+    /// cos and sin of the turn of each leaf.
+    turns: Vec<(f32, f32)>,
+}
+
+impl Spiral {
+    /// Makes sure the turns of the first `num_leaves` leaves are known.
+    fn extend_to(&mut self, num_leaves: usize) {
+        if self.turns.len() >= num_leaves {
+            return;
+        }
+        let (golden_sin, golden_cos) = GOLDEN_ANGLE.sin_cos();
+        let mut turn = self.turns.last().copied().unwrap_or((1.0, 0.0));
+        let more = num_leaves.max(2 * self.turns.len()).max(1024) - self.turns.len();
+        self.turns.extend((0..more).map(|_| {
+            let (c, s) = turn;
+            let (c, s) = (
+                c * golden_cos - s * golden_sin,
+                c * golden_sin + s * golden_cos,
+            );
+            let norm = (c * c + s * s).sqrt();
+            turn = (c / norm, s / norm);
+            turn
+        }));
+    }
 }
 
 /// [`build_leaves`] into `mesh` (cleared first, capacity reused), with `scratch` as working
@@ -125,9 +157,7 @@ pub(crate) fn build_leaves_into(
     // loop keeps many of its cache misses in flight), then made into leaves in that order.
     slots.clear();
     let mut rng = Rng::new(seed ^ 0x1eaf);
-    // The spiral turns by the golden angle per leaf: a running complex product, renormalised.
-    let (golden_sin, golden_cos) = GOLDEN_ANGLE.sin_cos();
-    let mut spiral = (1.0f32, 0.0f32);
+    let spiral = &mut scratch.spiral;
     for (index, node) in nodes.iter().enumerate() {
         if node.diameter >= params.max_branch_diameter {
             continue;
@@ -143,15 +173,13 @@ pub(crate) fn build_leaves_into(
             .try_normalize()
             .unwrap_or_else(|| any_perpendicular(heading));
         let up = heading.cross(left);
-        for k in 0..count {
-            let (c, s) = spiral;
-            let (c, s) = (
-                c * golden_cos - s * golden_sin,
-                c * golden_sin + s * golden_cos,
-            );
-            let norm = (c * c + s * s).sqrt();
-            spiral = (c / norm, s / norm);
-            let radial = left * spiral.0 + up * spiral.1;
+        let first_leaf = slots.len();
+        spiral.extend_to(first_leaf + count as usize);
+        for (k, &(cos, sin)) in spiral.turns[first_leaf..][..count as usize]
+            .iter()
+            .enumerate()
+        {
+            let radial = left * cos + up * sin;
             let along = (k as f32 + 0.5) / count as f32;
             let attachment = node.start.lerp(node.end, along) + radial * (0.5 * node.diameter);
             let slot = Attachment {
@@ -170,37 +198,61 @@ pub(crate) fn build_leaves_into(
     mesh.clear();
     mesh.reserve(slots.len() * 4, slots.len() * 6);
     let petiole = Petiole::new(params);
-    let mut groups = slots.chunks_exact(4);
+    for block in slots.chunks(LEAF_BLOCK) {
+        push_blades(mesh, &petiole, block);
+    }
+}
+
+/// Leaves written to the mesh per block: the block's vertices and indices are reserved in one
+/// step and filled in place.
+const LEAF_BLOCK: usize = 64;
+
+/// Appends the blades of the slots `block`, four at a time.
+fn push_blades(mesh: &mut TreeMesh, petiole: &Petiole, block: &[Attachment]) {
+    let base = mesh.positions.len() as u32;
+    let (positions, normals, uvs, ambient) = mesh.grow_vertices(4 * block.len());
+    let mut write = |leaf: usize, blade: &Blade, light: f32| {
+        let range = 4 * leaf..4 * leaf + 4;
+        positions[range.clone()].copy_from_slice(&blade.corners);
+        normals[range.clone()].fill(blade.normal);
+        uvs[range.clone()].copy_from_slice(&[[0.0, 1.0], [1.0, 1.0], [0.0, 0.0], [1.0, 0.0]]);
+        ambient[range].fill(light);
+    };
+    let mut groups = block.chunks_exact(4);
+    let mut leaf = 0;
     for group in &mut groups {
         let group: &[Attachment; 4] = group.try_into().expect("chunks of 4");
         match petiole.blades4(group) {
             Some(blades) => {
                 for (slot, blade) in group.iter().zip(&blades) {
-                    push_blade(mesh, blade, slot.light);
+                    write(leaf, blade, slot.light);
+                    leaf += 1;
                 }
             }
             None => {
                 for slot in group {
-                    push_blade(mesh, &petiole.blade(slot), slot.light);
+                    write(leaf, &petiole.blade(slot), slot.light);
+                    leaf += 1;
                 }
             }
         }
     }
     for slot in groups.remainder() {
-        push_blade(mesh, &petiole.blade(slot), slot.light);
+        write(leaf, &petiole.blade(slot), slot.light);
+        leaf += 1;
     }
-}
-
-fn push_blade(mesh: &mut TreeMesh, blade: &Blade, light: f32) {
-    let base = mesh.positions.len() as u32;
-    mesh.positions.extend_from_slice(&blade.corners);
-    mesh.normals.extend_from_slice(&[blade.normal; 4]);
-    mesh.uvs
-        .extend_from_slice(&[[0.0, 1.0], [1.0, 1.0], [0.0, 0.0], [1.0, 0.0]]);
-    mesh.ambient.extend_from_slice(&[light; 4]);
     // Counter-clockwise seen from the normal's side (H × L = U): base-left, tip-left, tip-right.
-    mesh.indices
-        .extend_from_slice(&[base, base + 2, base + 3, base, base + 3, base + 1]);
+    let indices = mesh.grow_indices(6 * block.len());
+    for (quad, corner) in indices.chunks_exact_mut(6).zip((base..).step_by(4)) {
+        quad.copy_from_slice(&[
+            corner,
+            corner + 2,
+            corner + 3,
+            corner,
+            corner + 3,
+            corner + 1,
+        ]);
+    }
 }
 
 /// Rotation of `v` about unit `axis` by `angle` (Rodrigues).
@@ -225,27 +277,52 @@ pub fn build_fruit_into(
     ambient: AmbientFn,
     mesh: &mut TreeMesh,
 ) {
+    let mut centers = Vec::new();
     for (index, node) in skeleton.internodes.iter().enumerate() {
-        if node.diameter >= params.max_branch_diameter {
+        fruit_centers(node, index as u32, params, &mut centers);
+    }
+    push_fruit(mesh, &centers, params, ambient);
+}
+
+/// Appends the centres of the fruit on the buds of `node` (arena index `index`) to `centers`,
+/// in bud order. A pure function of the internode, so the mesher finds the fruit in the same
+/// pass over the arena that copies the internodes.
+pub(crate) fn fruit_centers(
+    node: &Internode,
+    index: u32,
+    params: &FruitParams,
+    centers: &mut Vec<Vec3>,
+) {
+    if node.diameter >= params.max_branch_diameter {
+        return;
+    }
+    let light = node.light_exposure.clamp(0.0, 1.0);
+    // r < 1, so no bud of a node this dim wins: skip it without reading its buds.
+    if light * light <= params.threshold {
+        return;
+    }
+    let buds = node.terminal_bud.iter().chain(node.lateral_buds.iter());
+    let mut node_hash = None;
+    for (k, bud) in buds.enumerate().filter(|(_, b)| b.alive) {
+        let node_hash = *node_hash.get_or_insert_with(|| position_hash(node.end));
+        let r = hash_unit(node_hash ^ ((k as u64) << 48) ^ u64::from(index));
+        if r * light * light <= params.threshold {
             continue;
         }
-        let light = node.light_exposure.clamp(0.0, 1.0);
-        // r < 1, so no bud of a node this dim wins: skip it without reading its buds.
-        if light * light <= params.threshold {
-            continue;
-        }
-        let buds = node.terminal_bud.iter().chain(node.lateral_buds.iter());
-        let mut node_hash = None;
-        for (k, bud) in buds.enumerate().filter(|(_, b)| b.alive) {
-            let node_hash = *node_hash.get_or_insert_with(|| position_hash(node.end));
-            let r = hash_unit(node_hash ^ ((k as u64) << 48) ^ index as u64);
-            if r * light * light <= params.threshold {
-                continue;
-            }
-            let down = droop(bud.direction, params.droop);
-            let center = node.end + down * (params.radius * 1.2);
-            push_icosahedron(mesh, center, params.radius, ambient(center).clamp(0.0, 1.0));
-        }
+        let down = droop(bud.direction, params.droop);
+        centers.push(node.end + down * (params.radius * 1.2));
+    }
+}
+
+/// The fruit at `centers` appended to `mesh`.
+pub(crate) fn push_fruit(
+    mesh: &mut TreeMesh,
+    centers: &[Vec3],
+    params: &FruitParams,
+    ambient: AmbientFn,
+) {
+    for &center in centers {
+        push_icosahedron(mesh, center, params.radius, ambient(center).clamp(0.0, 1.0));
     }
 }
 
@@ -261,8 +338,25 @@ fn droop(direction: Vec3, angle: f32) -> Vec3 {
 
 /// Hash of a position quantised to 0.1 mm (the thesis XORs the components into a table index).
 fn position_hash(p: Vec3) -> u64 {
-    let q = |x: f32| (x * 1.0e4).round() as i64 as u64;
+    let q = |x: f32| round_to_i64(x * 1.0e4) as u64;
     q(p.x).wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ q(p.y).rotate_left(21) ^ q(p.z).rotate_left(42)
+}
+
+/// `x.round() as i64` (halves away from zero, saturating, NaN to 0) without a call to `round`,
+/// which is no instruction on baseline x86-64: truncate, then step away from zero when the
+/// dropped fraction is at least one half. The fraction is exact: below 2²³ the truncation is
+/// exact and so is the difference; from 2²³ on every float is an integer (and beyond the
+/// range of i64 the step saturates).
+fn round_to_i64(x: f32) -> i64 {
+    let truncated = x as i64;
+    let fraction = x - truncated as f32;
+    if fraction >= 0.5 {
+        truncated.saturating_add(1)
+    } else if fraction <= -0.5 {
+        truncated.saturating_sub(1)
+    } else {
+        truncated
+    }
 }
 
 fn push_icosahedron(mesh: &mut TreeMesh, center: Vec3, radius: f32, light: f32) {
@@ -306,11 +400,54 @@ fn push_icosahedron(mesh: &mut TreeMesh, center: Vec3, radius: f32, light: f32) 
     static NORMALS: std::sync::OnceLock<[Vec3; 12]> = std::sync::OnceLock::new();
     let normals = NORMALS.get_or_init(|| CORNERS.map(|corner| Vec3::from(corner).normalize()));
     let base = mesh.positions.len() as u32;
-    for &normal in normals {
-        let uv = [0.5 + 0.5 * normal.x, 0.5 - 0.5 * normal.y];
-        mesh.push_vertex(center + normal * radius, normal, uv, light);
+    let (positions, normals_out, uvs, ambient) = mesh.grow_vertices(CORNERS.len());
+    for (i, &normal) in normals.iter().enumerate() {
+        positions[i] = (center + normal * radius).to_array();
+        normals_out[i] = normal.to_array();
+        uvs[i] = [0.5 + 0.5 * normal.x, 0.5 - 0.5 * normal.y];
     }
-    for face in FACES {
-        mesh.indices.extend(face.iter().map(|&i| base + i));
+    ambient.fill(light);
+    let indices = mesh.grow_indices(3 * FACES.len());
+    for (triangle, face) in indices.chunks_exact_mut(3).zip(FACES) {
+        triangle.copy_from_slice(&face.map(|i| base + i));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn rounding_without_round_equals_round_for_halves_integers_extremes_and_nan() {
+        let mut values = vec![
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.5,
+            -1.5,
+            2.5,
+            -2.5,
+            0.499_999_97,
+            -0.499_999_97,
+            8_388_607.5,
+            -8_388_607.5,
+            8_388_608.0,
+            16_777_217.0,
+            1e12,
+            -1e12,
+            1e30,
+            -1e30,
+            f32::MAX,
+            f32::MIN,
+            f32::INFINITY,
+            f32::NEG_INFINITY,
+            f32::NAN,
+        ];
+        values.extend((0..100_000).map(|k| (hash_unit(k) - 0.5) * 2.0e5));
+        values.extend((0..20_000).map(|k| (k as f32 - 10_000.0) * 0.25));
+        for x in values {
+            assert_eq!(round_to_i64(x), x.round() as i64, "{x}");
+        }
     }
 }

@@ -2,12 +2,14 @@
 //! working memory (internode copies, topology, ring frames, leaf slots) kept between calls so
 //! that interactive re-meshing allocates nothing once its buffers have grown.
 
+use glam::Vec3;
+
 use super::branches::RingFrames;
 use super::leaves::{self, LeafScratch};
 use super::topology::BranchTopology;
 use super::{
-    AmbientFn, LOD_TRIANGLE_FRACTIONS, Lod, MaterialColors, MeshParams, NodeGeom, TreeMeshes,
-    prefix_indices,
+    AmbientFn, FruitParams, LOD_TRIANGLE_FRACTIONS, Lod, MaterialColors, MeshParams, NodeGeom,
+    TreeMeshes, prefix_indices,
 };
 use crate::tree::Skeleton;
 
@@ -42,6 +44,8 @@ pub struct Mesher {
     frames: RingFrames,
     leaf_scratch: LeafScratch,
     kept: Vec<bool>,
+    /// Centres of the fruit, in arena and bud order.
+    fruit_centers: Vec<Vec3>,
 }
 
 impl Mesher {
@@ -59,10 +63,7 @@ impl Mesher {
         levels: Levels,
         meshes: &mut TreeMeshes,
     ) {
-        NodeGeom::collect_into(skeleton, &mut self.nodes);
-        self.diameters.clear();
-        self.diameters
-            .extend(self.nodes.iter().map(|node| node.diameter));
+        self.collect(skeleton, params.fruit.as_ref());
         self.topology
             .build_with_diameters(skeleton, &self.diameters);
         self.frames
@@ -77,7 +78,7 @@ impl Mesher {
         );
         meshes.fruit.clear();
         if let Some(fruit) = &params.fruit {
-            leaves::build_fruit_into(skeleton, fruit, ambient, &mut meshes.fruit);
+            leaves::push_fruit(&mut meshes.fruit, &self.fruit_centers, fruit, ambient);
         }
         let levels = levels.range();
         meshes.lods.resize_with(levels.len(), Lod::default);
@@ -93,6 +94,21 @@ impl Mesher {
             leaf: params.leaf_color,
             fruit: params.fruit_color,
         };
+    }
+
+    /// The internode geometry and diameters, and the fruit centres, in one pass over the arena
+    /// (each internode is read once, while it is in cache).
+    fn collect(&mut self, skeleton: &Skeleton, fruit: Option<&FruitParams>) {
+        self.nodes.clear();
+        self.diameters.clear();
+        self.fruit_centers.clear();
+        for (index, node) in skeleton.internodes.iter().enumerate() {
+            self.nodes.push(NodeGeom::new(node));
+            self.diameters.push(node.diameter);
+            if let Some(fruit) = fruit {
+                leaves::fruit_centers(node, index as u32, fruit, &mut self.fruit_centers);
+            }
+        }
     }
 
     /// The branches of level `level`: all chains with their finest sides at level 0; coarser
@@ -122,7 +138,6 @@ mod tests {
     use super::*;
     use crate::geometry::synthetic::{branching_skeleton, crown_ambient};
     use crate::geometry::{FruitParams, build_level, build_meshes};
-    use glam::Vec3;
 
     #[test]
     fn one_level_built_alone_equals_that_level_of_a_full_build() {

@@ -93,6 +93,14 @@ impl Default for MeshParams {
     }
 }
 
+/// Vertices just added to a [`TreeMesh`]: positions, normals, uvs, ambient.
+pub(crate) type NewVertices<'a> = (
+    &'a mut [[f32; 3]],
+    &'a mut [[f32; 3]],
+    &'a mut [[f32; 2]],
+    &'a mut [f32],
+);
+
 /// An indexed triangle mesh with the attributes every tree part carries.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TreeMesh {
@@ -145,6 +153,31 @@ impl TreeMesh {
 
     pub fn is_empty(&self) -> bool {
         self.indices.is_empty()
+    }
+
+    /// Grows the vertex arrays by `count` vertices and returns the new ones, to be written:
+    /// positions, normals, uvs, ambient. The placeholders written first land in cache lines that
+    /// are overwritten at once, so they cost no extra memory traffic.
+    pub(crate) fn grow_vertices(&mut self, count: usize) -> NewVertices<'_> {
+        let start = self.positions.len();
+        let end = start + count;
+        self.positions.resize(end, [0.0; 3]);
+        self.normals.resize(end, [0.0; 3]);
+        self.uvs.resize(end, [0.0; 2]);
+        self.ambient.resize(end, 0.0);
+        (
+            &mut self.positions[start..],
+            &mut self.normals[start..],
+            &mut self.uvs[start..],
+            &mut self.ambient[start..],
+        )
+    }
+
+    /// Grows the index array by `count` indices and returns the new ones, to be written.
+    pub(crate) fn grow_indices(&mut self, count: usize) -> &mut [u32] {
+        let start = self.indices.len();
+        self.indices.resize(start + count, 0);
+        &mut self.indices[start..]
     }
 
     pub(crate) fn push_vertex(&mut self, position: Vec3, normal: Vec3, uv: [f32; 2], ambient: f32) {
