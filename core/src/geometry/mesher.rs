@@ -6,7 +6,7 @@ use glam::Vec3;
 
 use super::branches::RingFrames;
 use super::leaves::{self, LeafScratch};
-use super::topology::BranchTopology;
+use super::topology::{BranchTopology, Links};
 use super::{
     AmbientFn, FruitParams, LOD_TRIANGLE_FRACTIONS, Lod, MaterialColors, MeshParams, NodeGeom,
     TreeMeshes, prefix_indices,
@@ -46,6 +46,8 @@ pub struct Mesher {
     kept: Vec<bool>,
     /// Centres of the fruit, in arena and bud order.
     fruit_centers: Vec<Vec3>,
+    /// Parents and children of the internodes, for the topology.
+    links: Links,
 }
 
 impl Mesher {
@@ -64,8 +66,7 @@ impl Mesher {
         meshes: &mut TreeMeshes,
     ) {
         self.collect(skeleton, params.fruit.as_ref());
-        self.topology
-            .build_with_diameters(skeleton, &self.diameters);
+        self.topology.build_with_links(&self.links, &self.diameters);
         self.frames
             .build_into(&self.nodes, &self.topology, params, ambient);
         leaves::build_leaves_into(
@@ -96,15 +97,17 @@ impl Mesher {
         };
     }
 
-    /// The internode geometry and diameters, and the fruit centres, in one pass over the arena
-    /// (each internode is read once, while it is in cache).
+    /// The internode geometry, diameters and links, and the fruit centres, in one pass over the
+    /// arena (each internode is read once, while it is in cache).
     fn collect(&mut self, skeleton: &Skeleton, fruit: Option<&FruitParams>) {
         self.nodes.clear();
         self.diameters.clear();
         self.fruit_centers.clear();
+        self.links.clear();
         for (index, node) in skeleton.internodes.iter().enumerate() {
             self.nodes.push(NodeGeom::new(node));
             self.diameters.push(node.diameter);
+            self.links.push(node);
             if let Some(fruit) = fruit {
                 leaves::fruit_centers(node, index as u32, fruit, &mut self.fruit_centers);
             }

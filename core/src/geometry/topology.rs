@@ -3,7 +3,7 @@
 //! to that path is a child branch. Meshing along these chains leaves no cracks where a lateral
 //! dominates its parent axis.
 
-use crate::tree::Skeleton;
+use crate::tree::{Internode, Skeleton};
 
 /// Marks "none" in the `u32` links below.
 pub const NONE: u32 = u32::MAX;
@@ -44,35 +44,42 @@ impl BranchTopology {
 
     /// [`BranchTopology::build`] into `self`, reusing its buffers.
     pub fn build_into(&mut self, skeleton: &Skeleton) {
+        let mut links = Links::default();
+        links.clear();
+        for node in &skeleton.internodes {
+            links.push(node);
+        }
         let diameters: Vec<f32> = skeleton.internodes.iter().map(|n| n.diameter).collect();
-        self.build_with_diameters(skeleton, &diameters);
+        self.build_with_links(&links, &diameters);
     }
 
-    /// [`BranchTopology::build_into`] with the internode diameters given in arena order: a
-    /// compact array that stays in cache while the children are looked up.
-    pub(crate) fn build_with_diameters(&mut self, skeleton: &Skeleton, diameters: &[f32]) {
-        let nodes = &skeleton.internodes;
+    /// [`BranchTopology::build_into`] from the links of the skeleton and the internode
+    /// diameters in arena order: compact arrays that stay in cache while children and parents
+    /// are looked up, where the arena's internodes are large and each is read once already when
+    /// the links are made.
+    pub(crate) fn build_with_links(&mut self, links: &Links, diameters: &[f32]) {
+        let num_nodes = links.parents.len();
         self.visual_child.clear();
-        self.visual_child.extend(nodes.iter().map(|node| {
-            let mut best = NONE;
-            let mut best_diameter = f32::NEG_INFINITY;
-            for child in node.children() {
-                let diameter = diameters[child.index()];
-                if diameter > best_diameter {
-                    best = child.0;
-                    best_diameter = diameter;
+        self.visual_child
+            .extend(links.child_ranges.windows(2).map(|range| {
+                let mut best = NONE;
+                let mut best_diameter = f32::NEG_INFINITY;
+                for &child in &links.children[range[0] as usize..range[1] as usize] {
+                    let diameter = diameters[child as usize];
+                    if diameter > best_diameter {
+                        best = child;
+                        best_diameter = diameter;
+                    }
                 }
-            }
-            best
-        }));
+                best
+            }));
         let visual_child = &self.visual_child;
         self.chain_of_node.clear();
-        self.chain_of_node.resize(nodes.len(), NONE);
+        self.chain_of_node.resize(num_nodes, NONE);
         self.chain_nodes.clear();
-        self.chain_nodes.reserve(nodes.len());
+        self.chain_nodes.reserve(num_nodes);
         self.chains.clear();
-        for (index, node) in nodes.iter().enumerate() {
-            let parent_node = node.parent.map_or(NONE, |p| p.0);
+        for (index, &parent_node) in links.parents.iter().enumerate() {
             let starts_chain =
                 parent_node == NONE || visual_child[parent_node as usize] != index as u32;
             if !starts_chain {
@@ -108,10 +115,38 @@ impl BranchTopology {
     }
 }
 
+/// The links of a skeleton's internodes in compact arrays: the parent of each ([`NONE`] for
+/// the root) and its children (main child first, then the laterals, as
+/// [`Internode::children`] gives them).
+#[derive(Clone, Debug, Default)]
+pub(crate) struct Links {
+    parents: Vec<u32>,
+    /// The children of internode i are `children[child_ranges[i]..child_ranges[i + 1]]`.
+    child_ranges: Vec<u32>,
+    children: Vec<u32>,
+}
+
+impl Links {
+    /// Empties the links, keeping their capacity.
+    pub(crate) fn clear(&mut self) {
+        self.parents.clear();
+        self.children.clear();
+        self.child_ranges.clear();
+        self.child_ranges.push(0);
+    }
+
+    /// Appends the links of the next internode of the arena.
+    pub(crate) fn push(&mut self, node: &Internode) {
+        self.parents.push(node.parent.map_or(NONE, |p| p.0));
+        self.children.extend(node.children().map(|c| c.0));
+        self.child_ranges.push(self.children.len() as u32);
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::tree::{Internode, NodeId};
+    use crate::tree::NodeId;
     use glam::Vec3;
 
     fn node(parent: Option<u32>, start: Vec3, end: Vec3, diameter: f32) -> Internode {
