@@ -186,10 +186,15 @@ pub(crate) fn build_leaves_into(
                 point: attachment,
                 heading,
                 radial,
-                light: ambient(attachment).clamp(0.0, 1.0),
+                light: 0.0,
             };
             slots.push(slot);
         }
+    }
+    // The ambient light at every attachment, in a pass of its own: a call through the callback
+    // in the middle of the slot loop would save and restore its state.
+    for slot in slots.iter_mut() {
+        slot.light = ambient(slot.point).clamp(0.0, 1.0);
     }
     for i in 0..slots.len() {
         let j = rng.below(i as u32 + 1) as usize;
