@@ -355,21 +355,16 @@ impl OrbFeatures {
         Ok(Self { orb })
     }
 
+    /// Descriptors of the given keypoints (ORB drops those too near the border).
     fn run(
         &mut self,
         image: &GrayImage,
         keypoints: &mut Vector<KeyPoint>,
-        provided: bool,
     ) -> Result<Vec<Descriptor>> {
         let mat = mat_from_gray(image)?;
         let mut descriptors = Mat::default();
-        self.orb.detect_and_compute(
-            &mat,
-            &core::no_array(),
-            keypoints,
-            &mut descriptors,
-            provided,
-        )?;
+        self.orb
+            .detect_and_compute(&mat, &core::no_array(), keypoints, &mut descriptors, true)?;
         let mut out = Vec::with_capacity(keypoints.len());
         for row in 0..descriptors.rows() {
             let mut d = [0u8; 32];
@@ -381,14 +376,20 @@ impl OrbFeatures {
         Ok(out)
     }
 
-    /// Detects keypoints and describes them.
-    pub fn detect(&mut self, image: &GrayImage) -> Result<Vec<(Vec2, Descriptor)>> {
-        let mut keypoints = Vector::<KeyPoint>::new();
-        let descriptors = self.run(image, &mut keypoints, false)?;
-        Ok(keypoints
-            .iter()
-            .map(|k| Vec2::new(k.pt().x, k.pt().y))
-            .zip(descriptors)
+    /// Shi–Tomasi corners (as [`detect_corners`] finds them) with their descriptors: the way
+    /// map points are described, so the same corner seen again gives the same descriptor.
+    pub fn describe_corners(
+        &mut self,
+        image: &GrayImage,
+        max_corners: usize,
+        min_distance_px: f32,
+    ) -> Result<Vec<(Vec2, Descriptor)>> {
+        let corners = detect_corners(image, max_corners, min_distance_px, &[])?;
+        let described = self.describe(image, &corners)?;
+        Ok(corners
+            .into_iter()
+            .zip(described)
+            .filter_map(|(p, d)| Some((p, d?)))
             .collect())
     }
 
@@ -410,7 +411,7 @@ impl OrbFeatures {
                 p.x, p.y, 31.0, angle, 0.0, 0, i as i32,
             )?);
         }
-        let descriptors = self.run(image, &mut keypoints, true)?;
+        let descriptors = self.run(image, &mut keypoints)?;
         let mut out = vec![None; points.len()];
         for (k, d) in keypoints.iter().zip(descriptors) {
             if let Some(slot) = out.get_mut(k.class_id() as usize) {
@@ -450,6 +451,44 @@ fn intensity_centroid_angle_deg(image: &GrayImage, p: Vec2) -> Option<f32> {
 /// Hamming distance between two ORB descriptors.
 pub fn hamming(a: &Descriptor, b: &Descriptor) -> u32 {
     a.iter().zip(b).map(|(x, y)| (x ^ y).count_ones()).sum()
+}
+
+/// The nearest and second-nearest of the descriptors offered, for Lowe's ratio test.
+pub struct NearestTwo<T> {
+    best: u32,
+    second: u32,
+    best_item: Option<T>,
+}
+
+impl<T> Default for NearestTwo<T> {
+    fn default() -> Self {
+        Self {
+            best: u32::MAX,
+            second: u32::MAX,
+            best_item: None,
+        }
+    }
+}
+
+impl<T> NearestTwo<T> {
+    /// Offers `item` at Hamming `distance`; the first of equals stays the nearest.
+    pub fn offer(&mut self, distance: u32, item: T) {
+        if distance < self.best {
+            self.second = self.best;
+            self.best = distance;
+            self.best_item = Some(item);
+        } else if distance < self.second {
+            self.second = distance;
+        }
+    }
+
+    /// The nearest and its distance, when within `max_hamming` and clearly nearer than the
+    /// second (`best < ratio · second`; a lone candidate passes).
+    pub fn accepted(self, max_hamming: u32, ratio: f64) -> Option<(T, u32)> {
+        let item = self.best_item?;
+        let clear = self.second == u32::MAX || (self.best as f64) < ratio * self.second as f64;
+        (self.best <= max_hamming && clear).then_some((item, self.best))
+    }
 }
 
 /// Frames from a video file, an image-sequence pattern or a live camera (OpenCV videoio).

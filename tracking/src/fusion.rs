@@ -69,7 +69,7 @@ impl Tracker {
             let Some(descriptor) = descriptor else {
                 continue;
             };
-            let (mut best, mut second, mut best_id) = (u32::MAX, u32::MAX, None);
+            let mut nearest = crate::cv::NearestTwo::default();
             let (cx, cy) = cell(*pixel);
             for dy in -1..=1 {
                 for dx in -1..=1 {
@@ -77,22 +77,15 @@ impl Tracker {
                         continue;
                     };
                     for (id, projected, d) in list {
-                        if projected.distance(*pixel) > self.config.adopt_radius_px {
-                            continue;
-                        }
-                        let distance = crate::cv::hamming(&descriptor, d);
-                        if distance < best {
-                            (second, best, best_id) = (best, distance, Some(*id));
-                        } else if distance < second {
-                            second = distance;
+                        if projected.distance(*pixel) <= self.config.adopt_radius_px {
+                            nearest.offer(crate::cv::hamming(&descriptor, d), *id);
                         }
                     }
                 }
             }
-            let Some(id) = best_id else { continue };
-            if best > MAX_HAMMING || (second != u32::MAX && best as f64 >= RATIO * second as f64) {
+            let Some((id, best)) = nearest.accepted(MAX_HAMMING, RATIO) else {
                 continue;
-            }
+            };
             let entry = best_for_point.entry(id).or_insert((best, track_index));
             if best < entry.0 {
                 *entry = (best, track_index);

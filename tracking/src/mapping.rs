@@ -17,18 +17,14 @@ fn median_depth(map: &crate::map::Map, keyframe: usize) -> f64 {
     let Some(kf) = map.keyframes.get(keyframe) else {
         return 0.0;
     };
-    let mut depths: Vec<f64> = kf
-        .points
-        .iter()
-        .filter_map(|id| map.points.get(id))
-        .map(|p| kf.camera_from_world.transform_point(p.position).z)
-        .filter(|z| *z > 0.0)
-        .collect();
-    if depths.is_empty() {
-        return 0.0;
-    }
-    depths.sort_by(f64::total_cmp);
-    depths[depths.len() / 2]
+    crate::initializer::median(
+        kf.points
+            .iter()
+            .filter_map(|id| map.points.get(id))
+            .map(|p| kf.camera_from_world.transform_point(p.position).z)
+            .filter(|z| *z > 0.0)
+            .collect(),
+    )
 }
 
 /// Keyframe pyramids kept for the local-map search.

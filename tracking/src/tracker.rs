@@ -401,30 +401,15 @@ impl Tracker {
         if described.len() < 30 {
             return Ok(None);
         }
-        let features: Vec<(Vec2, crate::map::Descriptor)> = {
-            // The map's descriptors sit on Shi–Tomasi corners at full resolution: describe this
-            // frame's corners the same way, so the same corner gives the same descriptor.
-            let corners = cv::detect_corners(&frame.image, 1000, 7.0, &[])?;
-            let described = self.orb.describe(&frame.image, &corners)?;
-            corners
-                .into_iter()
-                .zip(described)
-                .filter_map(|(p, d)| Some((p, d?)))
-                .collect()
-        };
+        let features = self.orb.describe_corners(&frame.image, 1000, 7.0)?;
         let mut matches: Vec<(u64, DVec3, Vec2)> = Vec::new();
         for (pixel, descriptor) in &features {
-            let (mut best, mut second, mut best_k) = (u32::MAX, u32::MAX, 0);
+            let mut nearest = cv::NearestTwo::default();
             for (k, (_, _, d)) in described.iter().enumerate() {
-                let dist = cv::hamming(descriptor, d);
-                if dist < best {
-                    (second, best, best_k) = (best, dist, k);
-                } else if dist < second {
-                    second = dist;
-                }
+                nearest.offer(cv::hamming(descriptor, d), k);
             }
-            if best <= 50 && (best as f64) < 0.8 * second as f64 {
-                matches.push((described[best_k].0, described[best_k].1, *pixel));
+            if let Some((k, _)) = nearest.accepted(50, 0.8) {
+                matches.push((described[k].0, described[k].1, *pixel));
             }
         }
         let world: Vec<DVec3> = matches.iter().map(|m| m.1).collect();

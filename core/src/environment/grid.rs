@@ -119,30 +119,30 @@ impl SpatialGrid {
     /// (a superset of the points within the box) into `out`, replacing its contents.
     pub fn gather_box(&self, lo: Vec3, hi: Vec3, out: &mut Candidates) {
         out.clear();
-        if self.entry_index.is_empty() {
+        let Some((lo, hi)) = self.cell_range(lo, hi) else {
             return;
-        }
-        let lo = floor_to_ivec3((lo - self.origin) * self.inv_cell_size);
-        let hi = floor_to_ivec3((hi - self.origin) * self.inv_cell_size);
-        if hi.cmplt(IVec3::ZERO).any() || lo.cmpge(self.dims).any() {
-            return;
-        }
-        let lo = lo.max(IVec3::ZERO);
-        let hi = hi.min(self.dims - IVec3::ONE);
-        for z in lo.z..=hi.z {
-            for y in lo.y..=hi.y {
-                let row = self.cell_index(IVec3::new(lo.x, y, z));
-                let start = self.cell_start[row] as usize;
-                let end = self.cell_start[row + (hi.x - lo.x) as usize + 1] as usize;
-                for slot in start..end {
-                    let p = self.entry_position[slot];
-                    out.x.push(p.x);
-                    out.y.push(p.y);
-                    out.z.push(p.z);
-                }
-                out.index.extend_from_slice(&self.entry_index[start..end]);
+        };
+        for slots in self.rows(lo, hi) {
+            for &p in &self.entry_position[slots.clone()] {
+                out.x.push(p.x);
+                out.y.push(p.y);
+                out.z.push(p.z);
             }
+            out.index.extend_from_slice(&self.entry_index[slots]);
         }
+    }
+
+    /// The slots of the rows of cells `lo..=hi` (z, then y; cells along x are contiguous, so one
+    /// range covers a whole row), in increasing order.
+    #[inline]
+    fn rows(&self, lo: IVec3, hi: IVec3) -> impl Iterator<Item = std::ops::Range<usize>> + '_ {
+        (lo.z..=hi.z).flat_map(move |z| {
+            (lo.y..=hi.y).map(move |y| {
+                let row = self.cell_index(IVec3::new(lo.x, y, z));
+                self.cell_start[row] as usize
+                    ..self.cell_start[row + (hi.x - lo.x) as usize + 1] as usize
+            })
+        })
     }
 
     fn cell_index(&self, c: IVec3) -> usize {
@@ -172,11 +172,18 @@ impl SpatialGrid {
     /// the grid.
     #[inline]
     fn cell_box(&self, center: Vec3, radius: f32) -> Option<(IVec3, IVec3)> {
+        self.cell_range(center - Vec3::splat(radius), center + Vec3::splat(radius))
+    }
+
+    /// The cells that the box `lo..=hi` (world coordinates) overlaps, clamped to the grid, or
+    /// `None` when it misses the grid or the grid is empty.
+    #[inline]
+    fn cell_range(&self, lo: Vec3, hi: Vec3) -> Option<(IVec3, IVec3)> {
         if self.entry_index.is_empty() {
             return None;
         }
-        let lo = floor_to_ivec3((center - Vec3::splat(radius) - self.origin) * self.inv_cell_size);
-        let hi = floor_to_ivec3((center + Vec3::splat(radius) - self.origin) * self.inv_cell_size);
+        let lo = floor_to_ivec3((lo - self.origin) * self.inv_cell_size);
+        let hi = floor_to_ivec3((hi - self.origin) * self.inv_cell_size);
         if hi.cmplt(IVec3::ZERO).any() || lo.cmpge(self.dims).any() {
             return None;
         }
@@ -191,18 +198,12 @@ impl SpatialGrid {
             return;
         };
         let r2 = radius * radius;
-        for z in lo.z..=hi.z {
-            for y in lo.y..=hi.y {
-                let row = self.cell_index(IVec3::new(lo.x, y, z));
-                let start = self.cell_start[row] as usize;
-                let end = self.cell_start[row + (hi.x - lo.x) as usize + 1] as usize;
-                // Cells along x are contiguous: one scan covers the whole row.
-                for slot in start..end {
-                    let p = self.entry_position[slot];
-                    let d2 = p.distance_squared(center);
-                    if d2 <= r2 && f(slot, p, d2) {
-                        return;
-                    }
+        for slots in self.rows(lo, hi) {
+            for slot in slots {
+                let p = self.entry_position[slot];
+                let d2 = p.distance_squared(center);
+                if d2 <= r2 && f(slot, p, d2) {
+                    return;
                 }
             }
         }
