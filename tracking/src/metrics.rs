@@ -213,7 +213,9 @@ pub fn anchor_points(camera: &Camera, first_truth: &DAffine3, depth_m: f64) -> V
     points
 }
 
-/// Mean screen distance between the anchors seen through two `world_from_camera` poses.
+/// Mean screen distance between the anchors seen through two `world_from_camera` poses, over
+/// the anchors the true camera sees inside its image: an anchor out of view is not seen sliding,
+/// and the distortion polynomial diverges far outside the image. None when no anchor is in view.
 fn anchor_shift_px(
     camera: &Camera,
     anchors: &[DVec3],
@@ -226,7 +228,7 @@ fn anchor_shift_px(
         .filter_map(|a| {
             let e = camera.pixel_from_camera(est_inv.transform_point3(*a))?;
             let t = camera.pixel_from_camera(truth_inv.transform_point3(*a))?;
-            Some(e.distance(t))
+            camera.contains(t, 0.0).then(|| e.distance(t))
         })
         .collect();
     (!shifts.is_empty()).then(|| shifts.iter().sum::<f64>() / shifts.len() as f64)
