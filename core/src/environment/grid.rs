@@ -122,27 +122,25 @@ impl SpatialGrid {
         let Some((lo, hi)) = self.cell_range(lo, hi) else {
             return;
         };
-        for slots in self.rows(lo, hi) {
-            for &p in &self.entry_position[slots.clone()] {
-                out.x.push(p.x);
-                out.y.push(p.y);
-                out.z.push(p.z);
+        for z in lo.z..=hi.z {
+            for y in lo.y..=hi.y {
+                let slots = self.row_slots(y, z, lo.x, hi.x);
+                for &p in &self.entry_position[slots.clone()] {
+                    out.x.push(p.x);
+                    out.y.push(p.y);
+                    out.z.push(p.z);
+                }
+                out.index.extend_from_slice(&self.entry_index[slots]);
             }
-            out.index.extend_from_slice(&self.entry_index[slots]);
         }
     }
 
-    /// The slots of the rows of cells `lo..=hi` (z, then y; cells along x are contiguous, so one
-    /// range covers a whole row), in increasing order.
+    /// The slots of cells `x0..=x1` of the row (`y`, `z`): cells along x are contiguous, so one
+    /// range covers them, in increasing order.
     #[inline]
-    fn rows(&self, lo: IVec3, hi: IVec3) -> impl Iterator<Item = std::ops::Range<usize>> + '_ {
-        (lo.z..=hi.z).flat_map(move |z| {
-            (lo.y..=hi.y).map(move |y| {
-                let row = self.cell_index(IVec3::new(lo.x, y, z));
-                self.cell_start[row] as usize
-                    ..self.cell_start[row + (hi.x - lo.x) as usize + 1] as usize
-            })
-        })
+    fn row_slots(&self, y: i32, z: i32, x0: i32, x1: i32) -> std::ops::Range<usize> {
+        let row = self.cell_index(IVec3::new(x0, y, z));
+        self.cell_start[row] as usize..self.cell_start[row + (x1 - x0) as usize + 1] as usize
     }
 
     fn cell_index(&self, c: IVec3) -> usize {
@@ -191,23 +189,53 @@ impl SpatialGrid {
     }
 
     /// Visits the points within `radius` cell by cell (z, then y, then x: increasing slots) until
-    /// `f(slot, position, distance²)` returns true.
+    /// `f(slot, position, distance²)` returns true. Rows of cells that the sphere misses are
+    /// skipped and every row is trimmed to the cells its slice of the sphere overlaps (with a
+    /// margin for rounding, so no point within `radius` is ever left out).
     #[inline]
     fn scan_box(&self, center: Vec3, radius: f32, mut f: impl FnMut(usize, Vec3, f32) -> bool) {
         let Some((lo, hi)) = self.cell_box(center, radius) else {
             return;
         };
         let r2 = radius * radius;
-        for slots in self.rows(lo, hi) {
-            for slot in slots {
-                let p = self.entry_position[slot];
-                let d2 = p.distance_squared(center);
-                if d2 <= r2 && f(slot, p, d2) {
-                    return;
+        // In cell units: the centre, and the radius grown by the rounding margin.
+        let c = (center - self.origin) * self.inv_cell_size;
+        let reach = radius * self.inv_cell_size + CELL_MARGIN;
+        let reach2 = reach * reach;
+        for z in lo.z..=hi.z {
+            let gz = axis_gap(c.z, z);
+            for y in lo.y..=hi.y {
+                let gy = axis_gap(c.y, y);
+                let g2 = gy * gy + gz * gz;
+                if g2 > reach2 {
+                    continue;
+                }
+                let half = (reach2 - g2).sqrt();
+                let x0 = lo.x.max((c.x - half) as i32);
+                let x1 = hi.x.min((c.x + half) as i32);
+                if x0 > x1 {
+                    continue;
+                }
+                for slot in self.row_slots(y, z, x0, x1) {
+                    let p = self.entry_position[slot];
+                    let d2 = p.distance_squared(center);
+                    if d2 <= r2 && f(slot, p, d2) {
+                        return;
+                    }
                 }
             }
         }
     }
+}
+
+/// Slack of row trimming in cells: far more than the rounding of a cell coordinate.
+const CELL_MARGIN: f32 = 1e-3;
+
+/// Distance (in cells) from coordinate `c` to cell `i`'s interval [i, i + 1] along one axis.
+#[inline]
+fn axis_gap(c: f32, i: i32) -> f32 {
+    let i = i as f32;
+    (i - c).max(c - (i + 1.0)).max(0.0)
 }
 
 /// ⌊v⌋ per component without a libm call (x86-64's baseline has no SSE4.1 `roundps`, so

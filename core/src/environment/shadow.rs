@@ -20,6 +20,32 @@ const BRICK: i32 = 1 << BRICK_SHIFT;
 const BRICK_VOXELS: usize = (BRICK * BRICK * BRICK) as usize;
 /// Marks a brick-index cell that has no brick yet.
 const NO_BRICK: u32 = u32::MAX;
+/// Distance in voxels from `v` to brick `b`'s voxels along one axis (0 inside it).
+fn axis_gap(v: i32, b: i32) -> i32 {
+    let first = b << BRICK_SHIFT;
+    (first - v).max(v - (first + BRICK - 1)).max(0)
+}
+
+/// Voxels in one row of a brick (along x).
+const ROW: usize = BRICK as usize;
+/// `COLUMN_MASKS[x0][x1]`: all ones in lanes x0..=x1 of a brick row, zero elsewhere.
+const COLUMN_MASKS: [[[i32; ROW]; ROW]; ROW] = {
+    let mut masks = [[[0; ROW]; ROW]; ROW];
+    let mut x0 = 0;
+    while x0 < ROW {
+        let mut x1 = x0;
+        while x1 < ROW {
+            let mut x = x0;
+            while x <= x1 {
+                masks[x0][x1][x] = -1;
+                x += 1;
+            }
+            x1 += 1;
+        }
+        x0 += 1;
+    }
+    masks
+};
 /// Bricks are stored in chunks of this many, so adding one never moves the others.
 const BRICKS_PER_CHUNK: usize = 64;
 
@@ -70,11 +96,6 @@ impl ShadowGrid {
         &self.chunks[brick / BRICKS_PER_CHUNK][start..start + BRICK_VOXELS]
     }
 
-    fn brick_values_mut(&mut self, brick: usize) -> &mut [i32] {
-        let start = (brick % BRICKS_PER_CHUNK) * BRICK_VOXELS;
-        &mut self.chunks[brick / BRICKS_PER_CHUNK][start..start + BRICK_VOXELS]
-    }
-
     fn voxel_of(&self, point_in_world: Vec3) -> IVec3 {
         super::grid::floor_to_ivec3(point_in_world / self.voxel_size)
     }
@@ -107,6 +128,10 @@ impl ShadowGrid {
     }
 
     /// Adds (`sign` = 1) or removes (`sign` = −1) the shadow pyramid of a node.
+    ///
+    /// Brick by brick: each brick the pyramid reaches is looked up once, then the levels q that
+    /// lie in it add their square's rows there, each row one fixed 8-wide add of Δs masked to
+    /// the square's columns (two SIMD adds, no scalar loop).
     pub fn apply_node(&mut self, node_in_world: Vec3, sign: i32) {
         if self.level_units.is_empty() || !node_in_world.is_finite() {
             return;
@@ -116,41 +141,55 @@ impl ShadowGrid {
         let lo = top - IVec3::splat(q_max);
         let hi = top + IVec3::new(q_max, 0, q_max);
         self.ensure_index_covers(lo >> BRICK_SHIFT, hi >> BRICK_SHIFT);
-        for q in 0..=q_max {
-            let delta = sign * self.level_units[q as usize];
-            let lo = IVec3::new(top.x - q, top.y - q, top.z - q);
-            let hi = IVec3::new(top.x + q, top.y - q, top.z + q);
-            self.add_to_layer(lo, hi, delta);
-        }
-    }
-
-    /// Adds `delta` to the voxels `lo..=hi` of one horizontal layer (`lo.y == hi.y`), brick by
-    /// brick: each brick the square touches is looked up once, then each of its rows takes one
-    /// fixed 8-wide add of `delta` masked to the square's columns (two SIMD adds, no scalar loop).
-    fn add_to_layer(&mut self, lo: IVec3, hi: IVec3, delta: i32) {
-        let y = lo.y;
-        let (by, local_y) = (y >> BRICK_SHIFT, y & (BRICK - 1));
-        for bx in (lo.x >> BRICK_SHIFT)..=(hi.x >> BRICK_SHIFT) {
-            let x0 = lo.x.max(bx << BRICK_SHIFT) & (BRICK - 1);
-            let x1 = hi.x.min((bx << BRICK_SHIFT) + BRICK - 1) & (BRICK - 1);
-            let mut lanes = [0i32; BRICK as usize];
-            for (x, lane) in lanes.iter_mut().enumerate() {
-                if (x0..=x1).contains(&(x as i32)) {
-                    *lane = delta;
-                }
-            }
+        for by in (lo.y >> BRICK_SHIFT)..=(hi.y >> BRICK_SHIFT) {
+            // Levels whose layer y = top.y − q lies in this brick layer.
+            let q_lo = top.y - hi.y.min((by << BRICK_SHIFT) + BRICK - 1);
+            let q_hi = top.y - lo.y.max(by << BRICK_SHIFT);
             for bz in (lo.z >> BRICK_SHIFT)..=(hi.z >> BRICK_SHIFT) {
-                let z0 = lo.z.max(bz << BRICK_SHIFT) & (BRICK - 1);
-                let z1 = hi.z.min((bz << BRICK_SHIFT) + BRICK - 1) & (BRICK - 1);
-                let brick = self.brick_at(IVec3::new(bx, by, bz));
-                let values = self.brick_values_mut(brick);
-                for z in z0..=z1 {
-                    let base = (BRICK * (z + BRICK * local_y)) as usize;
-                    for (value, lane) in values[base..base + BRICK as usize].iter_mut().zip(lanes) {
-                        *value += lane;
+                let gap_z = axis_gap(top.z, bz);
+                for bx in (lo.x >> BRICK_SHIFT)..=(hi.x >> BRICK_SHIFT) {
+                    // The smallest level whose square reaches this brick column.
+                    let q_first = q_lo.max(gap_z).max(axis_gap(top.x, bx));
+                    if q_first > q_hi {
+                        continue;
+                    }
+                    let brick = self.brick_at(IVec3::new(bx, by, bz));
+                    for q in q_first..=q_hi {
+                        let delta = sign * self.level_units[q as usize];
+                        let layer =
+                            self.brick_layer_mut(brick, ((top.y - q) & (BRICK - 1)) as usize);
+                        let x0 = ((top.x - q).max(bx << BRICK_SHIFT) & (BRICK - 1)) as usize;
+                        let x1 = ((top.x + q).min((bx << BRICK_SHIFT) + BRICK - 1) & (BRICK - 1))
+                            as usize;
+                        let z0 = ((top.z - q).max(bz << BRICK_SHIFT) & (BRICK - 1)) as usize;
+                        let z1 = ((top.z + q).min((bz << BRICK_SHIFT) + BRICK - 1) & (BRICK - 1))
+                            as usize;
+                        let mut lanes = [0i32; ROW];
+                        for (lane, &m) in lanes.iter_mut().zip(&COLUMN_MASKS[x0][x1]) {
+                            *lane = delta & m;
+                        }
+                        for row in &mut layer[z0..=z1] {
+                            for (value, lane) in row.iter_mut().zip(lanes) {
+                                *value += lane;
+                            }
+                        }
                     }
                 }
             }
+        }
+    }
+
+    /// Layer `local_y` of brick `brick`: 8 rows (z) of 8 values (x).
+    fn brick_layer_mut(&mut self, brick: usize, local_y: usize) -> &mut [[i32; ROW]; ROW] {
+        let chunk = &mut self.chunks[brick / BRICKS_PER_CHUNK];
+        let bricks = chunk.as_chunks_mut::<BRICK_VOXELS>().0;
+        let layers = bricks[brick % BRICKS_PER_CHUNK]
+            .as_chunks_mut::<{ ROW * ROW }>()
+            .0;
+        let rows = layers[local_y & (ROW - 1)].as_chunks_mut::<ROW>().0;
+        match rows.try_into() {
+            Ok(rows) => rows,
+            Err(_) => unreachable!("a layer holds exactly 8 rows"),
         }
     }
 
