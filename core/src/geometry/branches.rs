@@ -329,7 +329,8 @@ impl RingFrames {
     }
 
     /// Emits one chain with `sides` sides; `parent_sides` is the side count of the parent at
-    /// this level (the first ring is laid onto a surface that polygonal).
+    /// this level (the first ring is laid onto a surface that polygonal). The chain's vertices
+    /// and indices are added in one step each and written in place.
     fn emit_chain(
         &self,
         mesh: &mut TreeMesh,
@@ -344,61 +345,113 @@ impl RingFrames {
         let rings =
             &self.rings[chain.first_ring as usize..(chain.first_ring + chain.num_rings) as usize];
         let du = chain.tiles_around / sides as f32;
-        let ring_size = sides as usize + 1;
+        let ring_size = table.len();
+        let first_vertex = mesh.positions.len() as u32;
+        let (positions, normals, uvs, ambient) = mesh.grow_vertices(rings.len() * ring_size);
+        let vertices = positions
+            .chunks_exact_mut(ring_size)
+            .zip(normals.chunks_exact_mut(ring_size))
+            .zip(uvs.chunks_exact_mut(ring_size))
+            .zip(ambient.chunks_exact_mut(ring_size));
         let laid = chain.tube.as_ref().zip(shrink);
-        for (ring_index, ring) in rings.iter().enumerate() {
-            let base = mesh.positions.len() as u32;
-            let (reference, binormal) = (ring.reference, ring.binormal);
+        for (ring_index, (ring, (((positions, normals), uvs), ambient))) in
+            rings.iter().zip(vertices).enumerate()
+        {
+            let out = RingOut {
+                positions,
+                normals,
+                uvs,
+            };
             match laid {
                 Some((tube, shrink)) if ring_index == 0 => {
-                    // Four vertices at a time, the rest (and any group with a degenerate
-                    // vertex) one by one.
-                    let mut k = 0;
-                    while k < table.len() {
-                        let group = table.get(k..k + 4).and_then(|cs| {
-                            let directions: [Vec3; 4] = std::array::from_fn(|i| {
-                                let (cos, sin) = cs[i];
-                                reference * cos + binormal * sin
-                            });
-                            onto_parent4(tube, ring, V4::gather(directions), shrink)
-                                .map(|positions| (directions, positions))
-                        });
-                        let Some((directions, positions)) = group else {
-                            let (cos, sin) = table[k];
-                            let direction = reference * cos + binormal * sin;
-                            let position = onto_parent(tube, ring, direction, shrink);
-                            let uv = [k as f32 * du + ring.u_offset, ring.v];
-                            mesh.push_vertex(position, direction, uv, ring.ambient);
-                            k += 1;
-                            continue;
-                        };
-                        for (i, direction) in directions.into_iter().enumerate() {
-                            let position = Vec3::from(positions.lane(i));
-                            let uv = [(k + i) as f32 * du + ring.u_offset, ring.v];
-                            mesh.push_vertex(position, direction, uv, ring.ambient);
-                        }
-                        k += 4;
-                    }
+                    laid_ring(out, table, ring, tube, shrink, du);
                 }
-                _ => {
-                    for (k, &(cos, sin)) in table.iter().enumerate() {
-                        let direction = reference * cos + binormal * sin;
-                        let position = ring.center + direction * ring.radius;
-                        mesh.push_vertex(
-                            position,
-                            direction,
-                            [k as f32 * du + ring.u_offset, ring.v],
-                            ring.ambient,
-                        );
-                    }
-                }
+                _ => plain_ring(out, table, ring, du),
             }
-            if ring_index > 0 {
-                let below = base - ring_size as u32;
-                mesh.indices
-                    .extend(pattern.iter().map(|&offset| below + offset));
+            ambient.fill(ring.ambient);
+        }
+        let indices = mesh.grow_indices(pattern.len() * (rings.len() - 1));
+        for (ring_index, quads) in indices.chunks_exact_mut(pattern.len()).enumerate() {
+            let below = first_vertex + (ring_index * ring_size) as u32;
+            for (index, &offset) in quads.iter_mut().zip(pattern) {
+                *index = below + offset;
             }
         }
+    }
+}
+
+/// The vertex attributes of one ring, to be written (the ambient is the ring's).
+struct RingOut<'a> {
+    positions: &'a mut [[f32; 3]],
+    normals: &'a mut [[f32; 3]],
+    uvs: &'a mut [[f32; 2]],
+}
+
+/// Writes a ring around its centre: vertex k in direction `reference·cos + binormal·sin` of the
+/// side table.
+fn plain_ring(out: RingOut, table: &[(f32, f32)], ring: &Ring, du: f32) {
+    let (reference, binormal) = (ring.reference, ring.binormal);
+    let vertices = out.positions.iter_mut().zip(out.normals).zip(out.uvs);
+    for (k, (((position, normal), uv), &(cos, sin))) in vertices.zip(table).enumerate() {
+        let direction = reference * cos + binormal * sin;
+        *position = (ring.center + direction * ring.radius).to_array();
+        *normal = direction.to_array();
+        *uv = [k as f32 * du + ring.u_offset, ring.v];
+    }
+}
+
+/// Writes a lateral chain's first ring laid onto its parent's surface, four vertices at a time
+/// (a ring has at least four vertices; the last group overlaps the one before when the count
+/// is not a multiple of four, and writes the shared vertices again with the same values). A
+/// group with a degenerate vertex is laid one vertex at a time.
+fn laid_ring(
+    out: RingOut,
+    table: &[(f32, f32)],
+    ring: &Ring,
+    tube: &ParentTube,
+    shrink: f32,
+    du: f32,
+) {
+    let (reference, binormal) = (ring.reference, ring.binormal);
+    let num_vertices = table.len();
+    let mut write = |k: usize, position: [f32; 3], direction: Vec3| {
+        out.positions[k] = position;
+        out.normals[k] = direction.to_array();
+        out.uvs[k] = [k as f32 * du + ring.u_offset, ring.v];
+    };
+    let mut start = 0;
+    while start < num_vertices {
+        let first = start.min(num_vertices.saturating_sub(4));
+        let Some(cs) = table.get(first..first + 4) else {
+            // Fewer than four vertices in all.
+            for (k, &(cos, sin)) in table.iter().enumerate() {
+                let direction = reference * cos + binormal * sin;
+                write(
+                    k,
+                    onto_parent(tube, ring, direction, shrink).to_array(),
+                    direction,
+                );
+            }
+            return;
+        };
+        let directions: [Vec3; 4] = std::array::from_fn(|i| {
+            let (cos, sin) = cs[i];
+            reference * cos + binormal * sin
+        });
+        match onto_parent4(tube, ring, V4::gather(directions), shrink) {
+            Some(positions) => {
+                for (i, &direction) in directions.iter().enumerate() {
+                    write(first + i, positions.lane(i), direction);
+                }
+            }
+            None => {
+                for (i, &direction) in directions.iter().enumerate() {
+                    let position = onto_parent(tube, ring, direction, shrink);
+                    write(first + i, position.to_array(), direction);
+                }
+            }
+        }
+        start = first + 4;
     }
 }
 

@@ -180,13 +180,6 @@ impl TreeMesh {
         &mut self.indices[start..]
     }
 
-    pub(crate) fn push_vertex(&mut self, position: Vec3, normal: Vec3, uv: [f32; 2], ambient: f32) {
-        self.positions.push(position.to_array());
-        self.normals.push(normal.to_array());
-        self.uvs.push(uv);
-        self.ambient.push(ambient);
-    }
-
     /// Axis-aligned bounds (min, max) of the vertices used by the first `num_indices` indices;
     /// `None` when there are none.
     pub fn bounds_of_prefix(&self, num_indices: usize) -> Option<(Vec3, Vec3)> {
