@@ -273,6 +273,35 @@ impl Candidates {
         self.index.is_empty()
     }
 
+    /// For a query whose sphere lies inside the gathered box: true when some gathered point lies
+    /// within `radius` of `center`, with distances computed exactly as the grid computes them
+    /// (so the answer is [`SpatialGrid::any_within`]'s).
+    pub fn any_within(&self, center: Vec3, radius: f32) -> bool {
+        const LANES: usize = 8;
+        let r2 = radius * radius;
+        let mut lanes = [f32::INFINITY; LANES];
+        let (xs, ys, zs) = (
+            self.x.chunks_exact(LANES),
+            self.y.chunks_exact(LANES),
+            self.z.chunks_exact(LANES),
+        );
+        let tail = (xs.remainder(), ys.remainder(), zs.remainder());
+        for ((x, y), z) in xs.zip(ys).zip(zs) {
+            for k in 0..LANES {
+                // (p − c)·(p − c), as glam's `distance_squared` sums it.
+                let (dx, dy, dz) = (x[k] - center.x, y[k] - center.y, z[k] - center.z);
+                let d2 = dx * dx + dy * dy + dz * dz;
+                lanes[k] = if d2 < lanes[k] { d2 } else { lanes[k] };
+            }
+        }
+        for (((m, &x), &y), &z) in lanes.iter_mut().zip(tail.0).zip(tail.1).zip(tail.2) {
+            let (dx, dy, dz) = (x - center.x, y - center.y, z - center.z);
+            let d2 = dx * dx + dy * dy + dz * dz;
+            *m = if d2 < *m { d2 } else { *m };
+        }
+        lanes.iter().any(|&d2| d2 <= r2)
+    }
+
     /// For a query whose sphere lies inside the gathered box: the nearest point within `radius`
     /// of `center` that `accept(index, position, distance²)` takes (it returns what to report),
     /// with its distance²; among equally near points the first that
@@ -410,6 +439,51 @@ mod tests {
                 );
             }
         }
+    }
+
+    #[test]
+    fn gathered_candidates_answer_occupancy_queries_like_the_grid() {
+        let mut rng = Rng::new(17);
+        let mut points: Vec<Vec3> = (0..2000).map(|_| rng.in_unit_ball() * 2.0).collect();
+        // Points exactly at the query radius from lattice centres (boundary cases).
+        for i in 0..50 {
+            points.push(Vec3::new(i as f32 * 0.1, 0.25, 0.0));
+        }
+        let mut grid = SpatialGrid::default();
+        grid.rebuild(&points, 0.3);
+        let mut candidates = Candidates::default();
+        let (mut inside, mut outside) = (0, 0);
+        for q in 0..300 {
+            let radius = if q % 3 == 0 {
+                0.25
+            } else {
+                rng.range_f32(0.01, 0.4)
+            };
+            let lo = if q % 3 == 0 {
+                Vec3::new((q % 40) as f32 * 0.1, 0.0, 0.0)
+            } else {
+                rng.in_unit_ball() * 2.5
+            };
+            let hi = lo + Vec3::splat(rng.range_f32(0.0, 0.3));
+            let reach = Vec3::splat(radius);
+            grid.gather_box(lo - reach, hi + reach, &mut candidates);
+            for k in 0..4 {
+                let t = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32());
+                let center = if k == 0 { lo } else { lo + (hi - lo) * t };
+                let expected = grid.any_within(center, radius);
+                assert_eq!(
+                    candidates.any_within(center, radius),
+                    expected,
+                    "{center} {radius}"
+                );
+                if expected {
+                    inside += 1;
+                } else {
+                    outside += 1;
+                }
+            }
+        }
+        assert!(inside > 100 && outside > 100, "{inside} {outside}");
     }
 
     #[test]

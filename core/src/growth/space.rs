@@ -85,8 +85,21 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
     scratch.point_grid.rebuild(&scratch.positions, perception);
     scratch.point_alive.clear();
     scratch.point_alive.resize(points.len(), false);
-    for (pi, position) in scratch.point_grid.entries() {
-        scratch.point_alive[pi as usize] = !scratch.node_grid.any_within(position, r);
+    // Cell by cell of the point grid: the nodes near the cell's points are gathered once, then
+    // each point tests that short list (the same distances as a radius query of the node grid).
+    for (cell, positions) in scratch.point_grid.cells() {
+        let (mut lo, mut hi) = (positions[0], positions[0]);
+        for &p in positions {
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+        let reach = Vec3::splat(r);
+        scratch
+            .node_grid
+            .gather_box(lo - reach, hi + reach, &mut scratch.candidates);
+        for (&pi, &position) in cell.iter().zip(positions) {
+            scratch.point_alive[pi as usize] = !scratch.candidates.any_within(position, r);
+        }
     }
     // Perception: each surviving point feeds its closest perceiving bud. The grid holds the
     // nodes with at least one competing bud (a node's buds share its position, so one distance
