@@ -22,6 +22,10 @@ pub struct SpatialGrid {
     entry_index: Vec<u32>,
     /// Position of each entry, sorted by cell (kept next to the index for cache-friendly scans).
     entry_position: Vec<Vec3>,
+    /// The same positions by coordinate, for gathering whole rows at once.
+    entry_x: Vec<f32>,
+    entry_y: Vec<f32>,
+    entry_z: Vec<f32>,
     cell_of: Vec<u32>,
 }
 
@@ -30,6 +34,9 @@ impl SpatialGrid {
     pub fn rebuild(&mut self, positions: &[Vec3], cell_size: f32) {
         self.entry_index.clear();
         self.entry_position.clear();
+        self.entry_x.clear();
+        self.entry_y.clear();
+        self.entry_z.clear();
         self.cell_start.clear();
         self.cell_of.clear();
         if positions.is_empty() {
@@ -65,6 +72,9 @@ impl SpatialGrid {
         }
         self.entry_index.resize(positions.len(), 0);
         self.entry_position.resize(positions.len(), Vec3::ZERO);
+        self.entry_x.resize(positions.len(), 0.0);
+        self.entry_y.resize(positions.len(), 0.0);
+        self.entry_z.resize(positions.len(), 0.0);
         // Fill each cell in input order (stable): the cursor is cell_start shifted by one.
         for (i, p) in positions.iter().enumerate() {
             let c = self.cell_of[i] as usize;
@@ -72,6 +82,9 @@ impl SpatialGrid {
             self.cell_start[c] += 1;
             self.entry_index[slot] = i as u32;
             self.entry_position[slot] = *p;
+            self.entry_x[slot] = p.x;
+            self.entry_y[slot] = p.y;
+            self.entry_z[slot] = p.z;
         }
         for c in (1..=num_cells).rev() {
             self.cell_start[c] = self.cell_start[c - 1];
@@ -125,11 +138,9 @@ impl SpatialGrid {
         for z in lo.z..=hi.z {
             for y in lo.y..=hi.y {
                 let slots = self.row_slots(y, z, lo.x, hi.x);
-                for &p in &self.entry_position[slots.clone()] {
-                    out.x.push(p.x);
-                    out.y.push(p.y);
-                    out.z.push(p.z);
-                }
+                out.x.extend_from_slice(&self.entry_x[slots.clone()]);
+                out.y.extend_from_slice(&self.entry_y[slots.clone()]);
+                out.z.extend_from_slice(&self.entry_z[slots.clone()]);
                 out.index.extend_from_slice(&self.entry_index[slots]);
             }
         }
