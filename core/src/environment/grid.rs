@@ -161,7 +161,33 @@ impl SpatialGrid {
     /// Calls `f(index, position, distance²)` for every stored point within `radius` of `center`,
     /// cell by cell and, within a cell, in input order (deterministic).
     pub fn for_each_within(&self, center: Vec3, radius: f32, mut f: impl FnMut(u32, Vec3, f32)) {
-        self.scan_box(center, radius, |slot, p, d2| {
+        let reach = Vec3::splat(radius);
+        self.scan_box(
+            center,
+            radius,
+            center - reach,
+            center + reach,
+            |slot, p, d2| {
+                f(self.entry_index[slot], p, d2);
+                false
+            },
+        );
+    }
+
+    /// [`SpatialGrid::for_each_within`] limited to the cells that overlap the box `lo..=hi`
+    /// (world coordinates): the same calls in the same order, except for points in cells
+    /// outside the box, which the caller knows it does not need.
+    pub fn for_each_within_box(
+        &self,
+        center: Vec3,
+        radius: f32,
+        lo: Vec3,
+        hi: Vec3,
+        mut f: impl FnMut(u32, Vec3, f32),
+    ) {
+        let reach = Vec3::splat(radius);
+        let (lo, hi) = (lo.max(center - reach), hi.min(center + reach));
+        self.scan_box(center, radius, lo, hi, |slot, p, d2| {
             f(self.entry_index[slot], p, d2);
             false
         });
@@ -170,18 +196,12 @@ impl SpatialGrid {
     /// True when some stored point lies within `radius` of `center` (stops at the first).
     pub fn any_within(&self, center: Vec3, radius: f32) -> bool {
         let mut found = false;
-        self.scan_box(center, radius, |_, _, _| {
+        let reach = Vec3::splat(radius);
+        self.scan_box(center, radius, center - reach, center + reach, |_, _, _| {
             found = true;
             true
         });
         found
-    }
-
-    /// The cells `lo..=hi` that a query sphere's bounding box overlaps, or `None` when it misses
-    /// the grid.
-    #[inline]
-    fn cell_box(&self, center: Vec3, radius: f32) -> Option<(IVec3, IVec3)> {
-        self.cell_range(center - Vec3::splat(radius), center + Vec3::splat(radius))
     }
 
     /// The cells that the box `lo..=hi` (world coordinates) overlaps, clamped to the grid, or
@@ -204,8 +224,15 @@ impl SpatialGrid {
     /// skipped and every row is trimmed to the cells its slice of the sphere overlaps (with a
     /// margin for rounding, so no point within `radius` is ever left out).
     #[inline]
-    fn scan_box(&self, center: Vec3, radius: f32, mut f: impl FnMut(usize, Vec3, f32) -> bool) {
-        let Some((lo, hi)) = self.cell_box(center, radius) else {
+    fn scan_box(
+        &self,
+        center: Vec3,
+        radius: f32,
+        lo: Vec3,
+        hi: Vec3,
+        mut f: impl FnMut(usize, Vec3, f32) -> bool,
+    ) {
+        let Some((lo, hi)) = self.cell_range(lo, hi) else {
             return;
         };
         let r2 = radius * radius;

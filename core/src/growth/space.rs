@@ -240,9 +240,15 @@ pub(crate) fn consume_and_perceive(
     let mut sum = Vec3::ZERO;
     let mut tropism = Vec3::ZERO;
     let mut count = 0;
+    // Only points in the occupancy sphere or in the perception cone matter: the scan keeps to
+    // the cells that overlap their bounding box (same points, same order).
+    let (cone_lo, cone_hi) = cone_bounds(heading, cos_half, perception);
+    let margin = Vec3::splat(BOX_MARGIN * perception);
+    let lo = tip + cone_lo.min(Vec3::splat(-r)) - margin;
+    let hi = tip + cone_hi.max(Vec3::splat(r)) + margin;
     scratch
         .point_grid
-        .for_each_within(tip, perception, |pi, p, d2| {
+        .for_each_within_box(tip, perception, lo, hi, |pi, p, d2| {
             if d2 <= consume_r2 {
                 alive[pi as usize] = false;
                 return;
@@ -267,6 +273,35 @@ pub(crate) fn consume_and_perceive(
     })
 }
 
+/// Slack of the perception cone's bounding box, relative to its radius: far more than the
+/// rounding of the cone test.
+const BOX_MARGIN: f32 = 1e-3;
+
+/// Bounding box, relative to its apex, of the cone of unit axis `axis`, half-angle with cosine
+/// `cos_half` and radius `radius` (the cone test's volume): along each world axis e, the extreme
+/// directions of the cone make the angle between e and the axis minus and plus the half-angle.
+fn cone_bounds(axis: Vec3, cos_half: f32, radius: f32) -> (Vec3, Vec3) {
+    let cos_half = cos_half.clamp(-1.0, 1.0);
+    let sin_half = (1.0 - cos_half * cos_half).max(0.0).sqrt();
+    let extent = |c: f32| {
+        let c = c.clamp(-1.0, 1.0);
+        let s = (1.0 - c * c).max(0.0).sqrt();
+        let high = if c >= cos_half {
+            1.0
+        } else {
+            c * cos_half + s * sin_half
+        };
+        let low = if -c >= cos_half {
+            -1.0
+        } else {
+            c * cos_half - s * sin_half
+        };
+        (low.min(0.0) * radius, high.max(0.0) * radius)
+    };
+    let (x, y, z) = (extent(axis.x), extent(axis.y), extent(axis.z));
+    (Vec3::new(x.0, y.0, z.0), Vec3::new(x.1, y.1, z.1))
+}
+
 /// Marks the points within the occupancy sphere of a new node as consumed.
 pub(crate) fn consume(scratch: &mut Scratch, node_end: Vec3, r: f32) {
     let alive = &mut scratch.point_alive;
@@ -283,4 +318,42 @@ pub(crate) fn finish_iteration(tree: &mut Tree, scratch: &Scratch) {
         index += 1;
         keep
     });
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_cone_box_holds_every_point_the_cone_test_accepts_and_is_tight() {
+        let mut rng = Rng::new(5);
+        for case in 0..400 {
+            let axis = if case % 4 == 0 {
+                [Vec3::X, Vec3::NEG_Y, Vec3::Z, Vec3::Y][case / 4 % 4]
+            } else {
+                rng.unit_vector()
+            };
+            let cos_half = rng.range_f32(-0.5, 1.0);
+            let radius = rng.range_f32(0.05, 2.0);
+            let (lo, hi) = cone_bounds(axis, cos_half, radius);
+            let margin = Vec3::splat(BOX_MARGIN * radius);
+            for _ in 0..500 {
+                let p = rng.in_unit_ball() * radius;
+                let d = p.length();
+                if d > 0.0 && p.dot(axis) >= cos_half * d {
+                    assert!(
+                        p.cmpge(lo - margin).all() && p.cmple(hi + margin).all(),
+                        "{p} outside {lo}..{hi} (axis {axis}, cos {cos_half})"
+                    );
+                }
+            }
+            // The apex is always inside; the box reaches no further than the cone does.
+            assert!(lo.cmple(Vec3::ZERO).all() && hi.cmpge(Vec3::ZERO).all());
+            let tip = axis * radius;
+            assert!(tip.cmpge(lo - margin).all() && tip.cmple(hi + margin).all());
+            if cos_half > 0.9 {
+                assert!((hi - lo).max_element() < 1.2 * radius, "{lo} {hi}");
+            }
+        }
+    }
 }
