@@ -88,15 +88,35 @@ pub(crate) fn update(
     let acc = &mut scratch.acc;
     acc.clear();
     acc.resize(n, 0.0);
+    // d_e^n of a tip, for the last exponent seen (almost always the same one).
+    let mut tip_mass = (f64::NAN, 0.0);
     for i in (0..n).rev() {
         let exponent = f64::from(exponents[i]);
+        // A node whose only child is an unconstrained inner node of its own subtree sums that
+        // child's mass alone (0 + m = m exactly), so its diameter is the child's: no power.
+        let chain_diameter = match (nodes[i].main_child, nodes[i].lateral_children.is_empty()) {
+            (Some(c), true) => {
+                let child = &nodes[c.index()];
+                let c = c.index();
+                (child.width_constraint.is_none()
+                    && !child.is_tip()
+                    && roots[c] == roots[i]
+                    && exponents[c] == exponents[i])
+                    .then_some(child.diameter)
+            }
+            _ => None,
+        };
         let node = &mut nodes[i];
         let (diameter, mass) = if let Some(d) = node.width_constraint {
             (d, f64::from(d).powf(exponent))
         } else if node.is_tip() {
-            (tip_diameter, f64::from(tip_diameter).powf(exponent))
+            if tip_mass.0 != exponent {
+                tip_mass = (exponent, f64::from(tip_diameter).powf(exponent));
+            }
+            (tip_diameter, tip_mass.1)
         } else {
-            ((acc[i].powf(1.0 / exponent)) as f32, acc[i])
+            let diameter = chain_diameter.unwrap_or_else(|| (acc[i].powf(1.0 / exponent)) as f32);
+            (diameter, acc[i])
         };
         node.diameter = diameter;
         if let Some(p) = node.parent {
