@@ -9,25 +9,10 @@ use glam::Vec3;
 
 use super::lanes::V4;
 use super::parent_tube::{ParentTube, onto_parent, onto_parent4};
+use super::rings::{Ring, carry_references, push_chain_rings};
 use super::topology::{BranchTopology, NONE};
-use super::{AmbientFn, BranchStart, MeshParams, NodeGeom, TreeMesh, any_perpendicular, hash_unit};
+use super::{AmbientFn, BranchStart, MeshParams, NodeGeom, TreeMesh};
 use crate::tree::NodeId;
-
-/// A ring of a generalized cylinder.
-#[derive(Clone, Copy, Debug)]
-pub(super) struct Ring {
-    pub(super) center: Vec3,
-    pub(super) tangent: Vec3,
-    /// Unit, perpendicular to `tangent`, carried by parallel transport along the chain.
-    pub(super) reference: Vec3,
-    /// `tangent × reference`.
-    pub(super) binormal: Vec3,
-    pub(super) radius: f32,
-    /// Bark texture coordinates: v along the path, u offset (the per-segment rotation).
-    pub(super) v: f32,
-    pub(super) u_offset: f32,
-    pub(super) ambient: f32,
-}
 
 /// The rings of one chain.
 #[derive(Clone, Copy, Debug)]
@@ -146,31 +131,6 @@ fn scaled_sides(sides: u32, side_scale: f32) -> u32 {
     ((sides as f32 * side_scale).round() as u32).max(3)
 }
 
-/// Carries `reference` from a ring at `from` with tangent `from_tangent` to the next ring by the
-/// double-reflection rotation-minimizing frame (Wang et al. 2008).
-fn transport(reference: Vec3, from: Vec3, from_tangent: Vec3, to: Vec3, to_tangent: Vec3) -> Vec3 {
-    let v1 = to - from;
-    let c1 = v1.length_squared();
-    let (reflected_ref, reflected_tangent) = if c1 > 1e-14 {
-        (
-            reference - v1 * (2.0 / c1 * v1.dot(reference)),
-            from_tangent - v1 * (2.0 / c1 * v1.dot(from_tangent)),
-        )
-    } else {
-        (reference, from_tangent)
-    };
-    let v2 = to_tangent - reflected_tangent;
-    let c2 = v2.length_squared();
-    let out = if c2 > 1e-14 {
-        reflected_ref - v2 * (2.0 / c2 * v2.dot(reflected_ref))
-    } else {
-        reflected_ref
-    };
-    (out - to_tangent * out.dot(to_tangent))
-        .try_normalize()
-        .unwrap_or_else(|| any_perpendicular(to_tangent))
-}
-
 impl RingFrames {
     /// The rings of every chain of `topology`, into `self` (buffers reused).
     pub(crate) fn build_into(
@@ -228,6 +188,11 @@ impl RingFrames {
                 tube,
             });
         }
+        let spans = self.chains.iter().map(|chain| {
+            let first = chain.first_ring as usize;
+            first..first + chain.num_rings as usize
+        });
+        carry_references(&mut self.rings, spans);
         self.by_diameter.clear();
     }
 
@@ -460,82 +425,4 @@ fn chain_triangles(chain: &ChainRings, side_scale: f32) -> usize {
         return 0;
     }
     2 * scaled_sides(chain.sides, side_scale) as usize * (chain.num_rings as usize - 1)
-}
-
-/// Appends the rings of one chain: a ring at the start of every internode and one at the tip.
-/// A lateral chain's first ring sits at the branching point (it is laid onto the parent surface
-/// when emitted); the following rings that still lie inside the parent tube are dropped.
-#[allow(clippy::too_many_arguments)]
-fn push_chain_rings(
-    rings: &mut Vec<Ring>,
-    geometry: &[NodeGeom],
-    tube: Option<&ParentTube>,
-    chain_nodes: &[u32],
-    params: &MeshParams,
-    tile_length: f32,
-    ambient: AmbientFn,
-) {
-    let first = &geometry[0];
-    let mut previous = Ring {
-        center: first.start,
-        tangent: first.heading,
-        reference: Vec3::ZERO,
-        binormal: Vec3::ZERO,
-        radius: 0.5 * first.diameter,
-        v: 0.0,
-        u_offset: 0.0,
-        ambient: ambient(first.start).clamp(0.0, 1.0),
-    };
-    previous.reference = (first.left - previous.tangent * first.left.dot(previous.tangent))
-        .try_normalize()
-        .unwrap_or_else(|| any_perpendicular(previous.tangent));
-    previous.binormal = previous.tangent.cross(previous.reference);
-    if let Some(tube) = tube {
-        previous.radius = previous.radius.min(0.85 * tube.joint_radius());
-    }
-    rings.push(previous);
-    let mut inside_parent = tube.is_some();
-    let mut arc_length = 0.0;
-    for (k, (node, &node_index)) in geometry.iter().zip(chain_nodes).enumerate() {
-        let heading = node.heading;
-        arc_length += node.length;
-        let (tangent, radius) = match geometry.get(k + 1) {
-            Some(next) => (
-                (heading + next.heading).try_normalize().unwrap_or(heading),
-                0.5 * next.diameter,
-            ),
-            None => (heading, 0.5 * node.diameter * params.tip_taper),
-        };
-        if let Some(tube) = tube.filter(|_| inside_parent) {
-            let (axis, parent_radius) = tube.at(node.end);
-            if node.end.distance(axis) < parent_radius {
-                continue;
-            }
-            inside_parent = false;
-        }
-        let reference = transport(
-            previous.reference,
-            previous.center,
-            previous.tangent,
-            node.end,
-            tangent,
-        );
-        let twist = params.bark_twist * (2.0 * hash_unit(u64::from(node_index)) - 1.0);
-        let ring = Ring {
-            center: node.end,
-            tangent,
-            reference,
-            binormal: tangent.cross(reference),
-            radius,
-            v: arc_length / tile_length,
-            u_offset: previous.u_offset + twist,
-            ambient: ambient(node.end).clamp(0.0, 1.0),
-        };
-        rings.push(ring);
-        previous = ring;
-    }
-    if inside_parent {
-        // The whole branch hides inside its parent: no geometry.
-        rings.pop();
-    }
 }

@@ -29,6 +29,7 @@ pub mod leaves;
 mod looks;
 mod mesher;
 mod parent_tube;
+mod rings;
 mod petiole;
 pub mod synthetic;
 pub mod textures;

@@ -5,7 +5,7 @@
 use glam::{Vec3, Vec4};
 
 use super::NodeGeom;
-use super::branches::Ring;
+use super::rings::Ring;
 use super::lanes::V4;
 use super::topology::{BranchTopology, NONE};
 
