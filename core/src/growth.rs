@@ -111,7 +111,18 @@ pub(crate) struct Scratch {
     pub in_mask: Vec<bool>,
     pub acc: Vec<f64>,
     pub subtree_root: Vec<u32>,
+    /// The arena's links as [`buds::collect`] found them, compact for the passes that follow
+    /// before the arena changes (vigor, shedding): parent and main child of node i
+    /// ([`NO_NODE`] for none), and its lateral children
+    /// `lateral[lateral_start[i]..lateral_start[i + 1]]` in order.
+    pub parent: Vec<u32>,
+    pub main_child: Vec<u32>,
+    pub lateral_start: Vec<u32>,
+    pub lateral: Vec<u32>,
 }
+
+/// No node, in [`Scratch`]'s compact links.
+pub(crate) const NO_NODE: u32 = u32::MAX;
 
 impl Clone for Scratch {
     fn clone(&self) -> Self {
@@ -228,7 +239,7 @@ impl Tree {
         } else {
             Vec::new()
         };
-        let removed = self.skeleton.subtree_flags(&shed);
+        let removed = subtree_flags(&scratch.parent, &shed);
         let grown = shoots::grow_all(self, &mut scratch, v_max, &removed, options.scene);
         stats.num_shoots = grown.0;
         stats.num_new_internodes = grown.1;
@@ -258,13 +269,15 @@ impl Tree {
     /// [`Tree::remove_subtrees`] given the flags of every internode to remove (closed under
     /// descendants, one per internode).
     fn remove_flagged_subtrees(&mut self, flags: &[bool]) -> usize {
-        let mut count = 0;
-        for (node, &gone) in self.skeleton.internodes.iter().zip(flags) {
-            if gone {
-                self.environment.shadow.apply_node(node.end, -1);
-                count += 1;
-            }
-        }
+        let gone_ends = self
+            .skeleton
+            .internodes
+            .iter()
+            .zip(flags)
+            .filter(|&(_, &gone)| gone)
+            .map(|(node, _)| node.end);
+        let count = gone_ends.clone().count();
+        self.environment.shadow.apply_nodes(gone_ends, -1);
         if count == 0 {
             return 0;
         }
@@ -381,6 +394,24 @@ impl Tree {
             age_years: self.age_years(),
         }
     }
+}
+
+/// [`crate::tree::Skeleton::subtree_flags`] from the compact parent links of the arena.
+fn subtree_flags(parent: &[u32], roots: &[NodeId]) -> Vec<bool> {
+    let mut flags = vec![false; parent.len()];
+    for r in roots {
+        if let Some(f) = flags.get_mut(r.index()) {
+            *f = true;
+        }
+    }
+    for i in 0..parent.len() {
+        if let Some(&p) = flags.get(parent[i] as usize)
+            && p
+        {
+            flags[i] = true;
+        }
+    }
+    flags
 }
 
 impl PartialEq for Tree {

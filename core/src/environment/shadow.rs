@@ -46,6 +46,11 @@ const COLUMN_MASKS: [[[i32; ROW]; ROW]; ROW] = {
     }
     masks
 };
+/// One horizontal layer of a brick, 8 rows (z) of 8 values (x), aligned to cache lines so that
+/// a row never straddles two.
+#[derive(Clone, Copy, Debug)]
+#[repr(C, align(64))]
+struct Layer([[i32; ROW]; ROW]);
 /// Bricks are stored in chunks of this many, so adding one never moves the others.
 const BRICKS_PER_CHUNK: usize = 64;
 
@@ -64,7 +69,7 @@ pub struct ShadowGrid {
     brick_of: Vec<u32>,
     /// Brick after brick in chunks of [`BRICKS_PER_CHUNK`], each brick 8³ values with x
     /// fastest, then z, then y.
-    chunks: Vec<Box<[i32]>>,
+    chunks: Vec<Box<[Layer]>>,
     num_bricks: usize,
 }
 
@@ -90,10 +95,10 @@ impl ShadowGrid {
         self.num_bricks * BRICK_VOXELS
     }
 
-    /// The values of brick `brick`.
-    fn brick_values(&self, brick: usize) -> &[i32] {
-        let start = (brick % BRICKS_PER_CHUNK) * BRICK_VOXELS;
-        &self.chunks[brick / BRICKS_PER_CHUNK][start..start + BRICK_VOXELS]
+    /// Layer `local_y` of brick `brick`: 8 rows (z) of 8 values (x).
+    fn brick_layer(&self, brick: usize, local_y: usize) -> &[[i32; ROW]; ROW] {
+        let layer = (brick % BRICKS_PER_CHUNK) * ROW + (local_y & (ROW - 1));
+        &self.chunks[brick / BRICKS_PER_CHUNK][layer].0
     }
 
     fn voxel_of(&self, point_in_world: Vec3) -> IVec3 {
@@ -122,9 +127,9 @@ impl ShadowGrid {
         if brick == NO_BRICK {
             return 0.0;
         }
-        let local = v & (BRICK - 1);
-        let i = (local.x + BRICK * (local.z + BRICK * local.y)) as usize;
-        self.brick_values(brick as usize)[i] as f32 / UNITS_PER_SHADOW
+        let local = (v & (BRICK - 1)).as_uvec3();
+        let layer = self.brick_layer(brick as usize, local.y as usize);
+        layer[local.z as usize][local.x as usize] as f32 / UNITS_PER_SHADOW
     }
 
     /// Adds (`sign` = 1) or removes (`sign` = −1) the shadow pyramid of a node.
@@ -179,18 +184,29 @@ impl ShadowGrid {
         }
     }
 
+    /// [`ShadowGrid::apply_node`] for many nodes: the same grid as one call each (integer
+    /// sums do not depend on the order), made in brick order so that neighbouring pyramids
+    /// find their bricks in cache.
+    pub fn apply_nodes(&mut self, nodes: impl IntoIterator<Item = Vec3>, sign: i32) {
+        let mut keyed: Vec<(u64, Vec3)> = nodes
+            .into_iter()
+            .map(|p| {
+                let b = (self.voxel_of(p) >> BRICK_SHIFT).as_uvec3().as_u64vec3();
+                // Brick coordinates as (y, z, x), each kept to 21 bits.
+                let mask = (1 << 21) - 1;
+                ((b.y & mask) << 42 | (b.z & mask) << 21 | (b.x & mask), p)
+            })
+            .collect();
+        keyed.sort_unstable_by_key(|&(key, _)| key);
+        for (_, p) in keyed {
+            self.apply_node(p, sign);
+        }
+    }
+
     /// Layer `local_y` of brick `brick`: 8 rows (z) of 8 values (x).
     fn brick_layer_mut(&mut self, brick: usize, local_y: usize) -> &mut [[i32; ROW]; ROW] {
-        let chunk = &mut self.chunks[brick / BRICKS_PER_CHUNK];
-        let bricks = chunk.as_chunks_mut::<BRICK_VOXELS>().0;
-        let layers = bricks[brick % BRICKS_PER_CHUNK]
-            .as_chunks_mut::<{ ROW * ROW }>()
-            .0;
-        let rows = layers[local_y & (ROW - 1)].as_chunks_mut::<ROW>().0;
-        match rows.try_into() {
-            Ok(rows) => rows,
-            Err(_) => unreachable!("a layer holds exactly 8 rows"),
-        }
+        let layer = (brick % BRICKS_PER_CHUNK) * ROW + (local_y & (ROW - 1));
+        &mut self.chunks[brick / BRICKS_PER_CHUNK][layer].0
     }
 
     /// The brick at brick coordinates `b` (inside the index box), allocated if missing.
@@ -201,7 +217,7 @@ impl ShadowGrid {
         if self.brick_of[cell] == NO_BRICK {
             if self.num_bricks == self.chunks.len() * BRICKS_PER_CHUNK {
                 self.chunks
-                    .push(vec![0; BRICKS_PER_CHUNK * BRICK_VOXELS].into_boxed_slice());
+                    .push(vec![Layer([[0; ROW]; ROW]); BRICKS_PER_CHUNK * ROW].into_boxed_slice());
             }
             self.brick_of[cell] = self.num_bricks as u32;
             self.num_bricks += 1;
@@ -243,7 +259,10 @@ impl ShadowGrid {
 
     /// True when every voxel is zero (no node casts shade).
     pub fn is_clear(&self) -> bool {
-        self.chunks.iter().all(|c| c.iter().all(|&v| v == 0))
+        self.chunks.iter().all(|c| {
+            c.iter()
+                .all(|layer| layer.0.iter().flatten().all(|&v| v == 0))
+        })
     }
 }
 

@@ -7,13 +7,13 @@
 //! v_l = v·(1 − λ)Q_l / (λQ_m + (1 − λ)Q_l) to the laterals, shared in proportion to their Q.
 
 use super::buds::TERMINAL;
-use super::{Scratch, Tree};
+use super::{NO_NODE, Scratch, Tree};
 use crate::tree::NodeId;
 
-/// Runs both passes; returns v_max, the largest vigor of an enabled bud (0 if none).
+/// Runs both passes; returns v_max, the largest vigor of an enabled bud (0 if none). The links
+/// come from the compact copy that [`super::buds::collect`] took of the arena.
 pub(crate) fn distribute(tree: &Tree, scratch: &mut Scratch) -> f32 {
-    let nodes = &tree.skeleton.internodes;
-    let n = nodes.len();
+    let n = tree.skeleton.internodes.len();
     let lambda = tree.species.apical_dominance;
     let Scratch {
         buds,
@@ -22,6 +22,9 @@ pub(crate) fn distribute(tree: &Tree, scratch: &mut Scratch) -> f32 {
         q_lateral,
         vigor,
         size,
+        main_child,
+        lateral_start,
+        lateral,
         ..
     } = scratch;
     q_main.clear();
@@ -32,8 +35,8 @@ pub(crate) fn distribute(tree: &Tree, scratch: &mut Scratch) -> f32 {
     vigor.resize(n, 0.0);
     size.clear();
     size.resize(n, 1);
+    let laterals = |i: usize| &lateral[lateral_start[i] as usize..lateral_start[i + 1] as usize];
     for i in (0..n).rev() {
-        let node = &nodes[i];
         let (mut qm, mut ql) = (0.0, 0.0);
         for bud in &buds[node_bud_start[i] as usize..node_bud_start[i + 1] as usize] {
             if bud.slot == TERMINAL {
@@ -43,13 +46,15 @@ pub(crate) fn distribute(tree: &Tree, scratch: &mut Scratch) -> f32 {
             }
         }
         let mut s = 1;
-        if let Some(c) = node.main_child {
-            qm += q_main[c.index()] + q_lateral[c.index()];
-            s += size[c.index()];
+        if main_child[i] != NO_NODE {
+            let c = main_child[i] as usize;
+            qm += q_main[c] + q_lateral[c];
+            s += size[c];
         }
-        for c in &node.lateral_children {
-            ql += q_main[c.index()] + q_lateral[c.index()];
-            s += size[c.index()];
+        for &c in laterals(i) {
+            let c = c as usize;
+            ql += q_main[c] + q_lateral[c];
+            s += size[c];
         }
         q_main[i] = qm;
         q_lateral[i] = ql;
@@ -60,7 +65,6 @@ pub(crate) fn distribute(tree: &Tree, scratch: &mut Scratch) -> f32 {
     }
     let mut v_max = 0.0f32;
     for i in 0..n {
-        let node = &nodes[i];
         let (qm, ql) = (q_main[i], q_lateral[i]);
         let denominator = lambda * qm + (1.0 - lambda) * ql;
         let (vm, vl) = if denominator > 0.0 {
@@ -74,16 +78,18 @@ pub(crate) fn distribute(tree: &Tree, scratch: &mut Scratch) -> f32 {
         };
         // v_l shared among lateral elements in proportion to their Q.
         let lateral_share = if ql > 0.0 { vl / ql } else { 0.0 };
-        if let Some(c) = node.main_child {
-            vigor[c.index()] = vm;
+        let has_main_child = main_child[i] != NO_NODE;
+        if has_main_child {
+            vigor[main_child[i] as usize] = vm;
         }
-        for c in &node.lateral_children {
-            vigor[c.index()] = lateral_share * (q_main[c.index()] + q_lateral[c.index()]);
+        for &c in laterals(i) {
+            let c = c as usize;
+            vigor[c] = lateral_share * (q_main[c] + q_lateral[c]);
         }
         for bud in &mut buds[node_bud_start[i] as usize..node_bud_start[i + 1] as usize] {
             bud.vigor = if bud.slot == TERMINAL {
                 // The terminal bud shares v_m with nothing: a node with a bud has no main child.
-                if node.main_child.is_some() { 0.0 } else { vm }
+                if has_main_child { 0.0 } else { vm }
             } else {
                 lateral_share * bud.q
             };
@@ -103,15 +109,15 @@ pub(crate) fn select_shed(tree: &Tree, scratch: &mut Scratch, v_max: f32) -> Vec
         return Vec::new();
     }
     let scale = super::shoots::max_shoot_internodes(tree) / v_max;
-    let mut shed = Vec::new();
-    let nodes = &tree.skeleton.internodes;
-    for node in nodes {
-        for &c in &node.lateral_children {
-            let ratio = scratch.vigor[c.index()] * scale / scratch.size[c.index()] as f32;
-            if ratio < threshold && scratch.in_mask[c.index()] {
-                shed.push(c);
-            }
-        }
-    }
-    shed
+    // Every lateral child of every node, in node order.
+    scratch
+        .lateral
+        .iter()
+        .map(|&c| c as usize)
+        .filter(|&c| {
+            let ratio = scratch.vigor[c] * scale / scratch.size[c] as f32;
+            ratio < threshold && scratch.in_mask[c]
+        })
+        .map(|c| NodeId(c as u32))
+        .collect()
 }
