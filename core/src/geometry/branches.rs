@@ -26,8 +26,6 @@ struct ChainRings {
     base_diameter: f32,
     /// Bark tiles around the circumference.
     tiles_around: f32,
-    /// The parent's surface where a lateral chain starts; `None` for the trunk.
-    tube: Option<ParentTube>,
 }
 
 /// cos/sin of `k·2π/C` for k in 0..=C, and the indices of the 2C triangles joining two rings
@@ -95,6 +93,9 @@ impl SideTables {
 pub(crate) struct RingFrames {
     rings: Vec<Ring>,
     chains: Vec<ChainRings>,
+    /// The parent's surface where each lateral chain starts; `None` for the trunk. Apart from
+    /// `chains`, which the level-of-detail passes read whole and look up by parent.
+    tubes: Vec<Option<ParentTube>>,
     /// Chains keyed by base diameter, thickest first (parents before children on ties): the
     /// chain index in the low 32 bits. Sorted on demand by the coarser levels.
     by_diameter: Vec<u64>,
@@ -158,6 +159,8 @@ impl RingFrames {
         rings.reserve(nodes.len() + topology.chains.len());
         chains.clear();
         chains.reserve(topology.chains.len());
+        self.tubes.clear();
+        self.tubes.reserve(topology.chains.len());
         for (chain_index, chain) in topology.chains.iter().enumerate() {
             let chain_nodes = topology.nodes_of(chain_index);
             let geometry = &chain_geometry[chain.first as usize..][..chain_nodes.len()];
@@ -185,8 +188,8 @@ impl RingFrames {
                 sides: contour_sides(base_diameter, thinnest, params.side_exponent, max_sides),
                 base_diameter: raw_diameter,
                 tiles_around,
-                tube,
             });
+            self.tubes.push(tube);
         }
         let spans = self.chains.iter().map(|chain| {
             let first = chain.first_ring as usize;
@@ -286,6 +289,7 @@ impl RingFrames {
             self.emit_chain(
                 mesh,
                 chain,
+                self.tubes[index].as_ref(),
                 sides,
                 parent.map(|(_, parent_sides)| parent_sides),
             );
@@ -294,12 +298,12 @@ impl RingFrames {
     }
 
     /// Emits one chain with `sides` sides; `parent_sides` is the side count of the parent at
-    /// this level (the first ring is laid onto a surface that polygonal). The chain's vertices
-    /// and indices are added in one step each and written in place.
+    /// this level (the first ring is laid onto `tube`, a surface that polygonal).
     fn emit_chain(
         &self,
         mesh: &mut TreeMesh,
         chain: &ChainRings,
+        tube: Option<&ParentTube>,
         sides: u32,
         parent_sides: Option<u32>,
     ) {
@@ -311,58 +315,45 @@ impl RingFrames {
             &self.rings[chain.first_ring as usize..(chain.first_ring + chain.num_rings) as usize];
         let du = chain.tiles_around / sides as f32;
         let ring_size = table.len();
-        let first_vertex = mesh.positions.len() as u32;
-        let (positions, normals, uvs, ambient) = mesh.grow_vertices(rings.len() * ring_size);
-        let vertices = positions
-            .chunks_exact_mut(ring_size)
-            .zip(normals.chunks_exact_mut(ring_size))
-            .zip(uvs.chunks_exact_mut(ring_size))
-            .zip(ambient.chunks_exact_mut(ring_size));
-        let laid = chain.tube.as_ref().zip(shrink);
-        for (ring_index, (ring, (((positions, normals), uvs), ambient))) in
-            rings.iter().zip(vertices).enumerate()
-        {
-            let out = RingOut {
-                positions,
-                normals,
-                uvs,
-            };
-            match laid {
-                Some((tube, shrink)) if ring_index == 0 => {
-                    laid_ring(out, table, ring, tube, shrink, du);
-                }
-                _ => plain_ring(out, table, ring, du),
-            }
-            ambient.fill(ring.ambient);
+        let first_vertex = mesh.positions.len();
+        // Every attribute is appended from an iterator of known length, written once in place.
+        for ring in rings {
+            let (reference, binormal) = (ring.reference, ring.binormal);
+            let direction = |&(cos, sin): &(f32, f32)| reference * cos + binormal * sin;
+            mesh.positions.extend(
+                table
+                    .iter()
+                    .map(|cs| (ring.center + direction(cs) * ring.radius).to_array()),
+            );
+            mesh.normals
+                .extend(table.iter().map(|cs| direction(cs).to_array()));
+            mesh.uvs
+                .extend((0..ring_size).map(|k| [k as f32 * du + ring.u_offset, ring.v]));
+            mesh.ambient
+                .extend(std::iter::repeat_n(ring.ambient, ring_size));
         }
-        let indices = mesh.grow_indices(pattern.len() * (rings.len() - 1));
-        for (ring_index, quads) in indices.chunks_exact_mut(pattern.len()).enumerate() {
-            let below = first_vertex + (ring_index * ring_size) as u32;
-            for (index, &offset) in quads.iter_mut().zip(pattern) {
-                *index = below + offset;
-            }
+        if let Some((tube, shrink)) = tube.zip(shrink) {
+            // The first ring, written round its centre above, is laid onto the parent.
+            let out = RingOut {
+                positions: &mut mesh.positions[first_vertex..][..ring_size],
+                normals: &mut mesh.normals[first_vertex..][..ring_size],
+                uvs: &mut mesh.uvs[first_vertex..][..ring_size],
+            };
+            laid_ring(out, table, &rings[0], tube, shrink, du);
+        }
+        for ring_index in 0..rings.len() - 1 {
+            let below = (first_vertex + ring_index * ring_size) as u32;
+            mesh.indices
+                .extend(pattern.iter().map(|&offset| below + offset));
         }
     }
 }
 
-/// The vertex attributes of one ring, to be written (the ambient is the ring's).
+/// The vertex attributes of a laid first ring, to be written (the ambient is the ring's).
 struct RingOut<'a> {
     positions: &'a mut [[f32; 3]],
     normals: &'a mut [[f32; 3]],
     uvs: &'a mut [[f32; 2]],
-}
-
-/// Writes a ring around its centre: vertex k in direction `reference·cos + binormal·sin` of the
-/// side table.
-fn plain_ring(out: RingOut, table: &[(f32, f32)], ring: &Ring, du: f32) {
-    let (reference, binormal) = (ring.reference, ring.binormal);
-    let vertices = out.positions.iter_mut().zip(out.normals).zip(out.uvs);
-    for (k, (((position, normal), uv), &(cos, sin))) in vertices.zip(table).enumerate() {
-        let direction = reference * cos + binormal * sin;
-        *position = (ring.center + direction * ring.radius).to_array();
-        *normal = direction.to_array();
-        *uv = [k as f32 * du + ring.u_offset, ring.v];
-    }
 }
 
 /// Writes a lateral chain's first ring laid onto its parent's surface, four vertices at a time
