@@ -119,6 +119,9 @@ pub(crate) struct Scratch {
     pub main_child: Vec<u32>,
     pub lateral_start: Vec<u32>,
     pub lateral: Vec<u32>,
+    /// Start and end of every internode as collect found them (occupancy, gravimorphism).
+    pub node_start: Vec<Vec3>,
+    pub node_end: Vec<Vec3>,
 }
 
 /// No node, in [`Scratch`]'s compact links.

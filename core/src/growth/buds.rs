@@ -60,6 +60,8 @@ pub(crate) fn collect(tree: &mut Tree, scratch: &mut Scratch) {
     scratch.main_child.clear();
     scratch.lateral_start.clear();
     scratch.lateral.clear();
+    scratch.node_start.clear();
+    scratch.node_end.clear();
     scratch.in_mask.clear();
     scratch
         .in_mask
@@ -83,6 +85,8 @@ pub(crate) fn collect(tree: &mut Tree, scratch: &mut Scratch) {
                 bud.alive = false;
             }
         }
+        scratch.node_start.push(node.start);
+        scratch.node_end.push(node.end);
         scratch.parent.push(node.parent.map_or(NO_NODE, |p| p.0));
         scratch
             .main_child
