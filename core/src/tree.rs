@@ -189,20 +189,21 @@ impl Skeleton {
             });
         }
         remap.resize(self.internodes.len(), None);
-        // Compact in place (each kept node moved once, towards the front), then renumber links.
+        // Compact in place (each kept node renumbered, then moved once towards the front).
         let mut read = 0;
-        self.internodes.retain(|_| {
+        self.internodes.retain_mut(|node| {
             read += 1;
-            remap[read - 1].is_some()
-        });
-        for node in &mut self.internodes {
+            if remap[read - 1].is_none() {
+                return false;
+            }
             node.parent = node.parent.and_then(|p| remap[p.index()]);
             node.main_child = node.main_child.and_then(|c| remap[c.index()]);
             node.lateral_children.retain(|c| remap[c.index()].is_some());
             for c in &mut node.lateral_children {
                 *c = remap[c.index()].unwrap_or(*c);
             }
-        }
+            true
+        });
         remap
     }
 
