@@ -96,6 +96,36 @@ impl SpatialGrid {
         self.entry_index.len()
     }
 
+    /// Keeps only the entries whose original index `keep` accepts, in place: the cells, and the
+    /// order of the kept entries within them, stay as they were.
+    pub fn retain(&mut self, keep: impl Fn(u32) -> bool) {
+        let mut write = 0;
+        let mut start = 0;
+        for c in 0..self.cell_start.len().saturating_sub(1) {
+            let end = self.cell_start[c + 1] as usize;
+            self.cell_start[c] = write as u32;
+            for read in start..end {
+                if keep(self.entry_index[read]) {
+                    self.entry_index[write] = self.entry_index[read];
+                    self.entry_position[write] = self.entry_position[read];
+                    self.entry_x[write] = self.entry_x[read];
+                    self.entry_y[write] = self.entry_y[read];
+                    self.entry_z[write] = self.entry_z[read];
+                    write += 1;
+                }
+            }
+            start = end;
+        }
+        if let Some(last) = self.cell_start.last_mut() {
+            *last = write as u32;
+        }
+        self.entry_index.truncate(write);
+        self.entry_position.truncate(write);
+        self.entry_x.truncate(write);
+        self.entry_y.truncate(write);
+        self.entry_z.truncate(write);
+    }
+
     pub fn is_empty(&self) -> bool {
         self.entry_index.is_empty()
     }
@@ -522,6 +552,26 @@ mod tests {
             }
         }
         assert!(inside > 100 && outside > 100, "{inside} {outside}");
+    }
+
+    #[test]
+    fn retained_grids_answer_queries_over_the_kept_points_in_the_same_order() {
+        let mut rng = Rng::new(21);
+        let points: Vec<Vec3> = (0..1500).map(|_| rng.in_unit_ball() * 2.0).collect();
+        let mut grid = SpatialGrid::default();
+        grid.rebuild(&points, 0.4);
+        let mut kept = grid.clone();
+        kept.retain(|i| i % 3 != 0);
+        assert_eq!(kept.len(), points.len() - points.len().div_ceil(3));
+        for _ in 0..100 {
+            let center = rng.in_unit_ball() * 2.0;
+            let radius = rng.range_f32(0.0, 1.0);
+            let (mut all, mut some) = (Vec::new(), Vec::new());
+            grid.for_each_within(center, radius, |i, p, d2| all.push((i, p, d2)));
+            kept.for_each_within(center, radius, |i, p, d2| some.push((i, p, d2)));
+            all.retain(|&(i, _, _)| i % 3 != 0);
+            assert_eq!(all, some);
+        }
     }
 
     #[test]

@@ -171,6 +171,10 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
             }
         }
     }
+    // The shoots' scans only ever look at surviving points: the grid keeps only them (same
+    // cells, same order).
+    let alive = &scratch.point_alive;
+    scratch.point_grid.retain(|pi| alive[pi as usize]);
     let mut alive_count = 0;
     for (pi, point) in points.iter().enumerate() {
         if !scratch.point_alive[pi] {
