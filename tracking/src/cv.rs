@@ -43,7 +43,9 @@ fn mat_from_gray(image: &GrayImage) -> Result<Mat> {
     Ok(borrowed.try_clone()?)
 }
 
-/// An image pyramid for Lucas–Kanade, built once per frame and reused by every track call.
+/// An image pyramid for OpenCV's Lucas–Kanade. The tracker uses the project's own
+/// [`crate::lk`]; OpenCV's stays as the reference it is checked against (`lk_compare` example,
+/// `tests/tests/lk_against_opencv.rs`).
 pub struct Pyramid {
     levels: Vector<Mat>,
 }
@@ -109,46 +111,26 @@ fn lk(
         .collect())
 }
 
-/// How a set of points is followed by [`track_points`].
-#[derive(Clone, Copy, Debug)]
-pub struct LkOptions {
-    /// Pyramid levels above the base searched (coarse to fine); fewer when the guess is good.
-    pub levels: i32,
-    /// Forward-backward check: a track survives when tracking it back lands within this many
-    /// pixels of where it started. None skips the backward pass (half the cost) where another
-    /// test (a reprojection gate) rejects wrong matches.
-    pub max_fb_error_px: Option<f32>,
-}
-
-/// Pyramidal Lucas–Kanade from `prev` to `next`, optionally with a forward-backward check.
-/// `guess` seeds the forward search (e.g. projections of map points).
+/// OpenCV's pyramidal Lucas–Kanade from `prev` to `next`, optionally with a forward-backward
+/// check; `guess` seeds the forward search. The reference for [`crate::lk::track_points`].
 pub fn track_points(
     prev: &Pyramid,
     next: &Pyramid,
     from: &[Vec2],
     guess: Option<&[Vec2]>,
-    options: LkOptions,
+    options: crate::lk::LkOptions,
 ) -> Result<Vec<Option<Vec2>>> {
     if from.is_empty() {
         return Ok(Vec::new());
     }
-    let forward = lk(prev, next, from, guess, options.levels)?;
+    let levels = options.levels as i32;
+    let forward = lk(prev, next, from, guess, levels)?;
     let Some(max_fb_error_px) = options.max_fb_error_px else {
         return Ok(forward);
     };
-    let alive: Vec<usize> = (0..from.len()).filter(|&i| forward[i].is_some()).collect();
-    let there: Vec<Vec2> = alive.iter().filter_map(|&i| forward[i]).collect();
-    let back_guess: Vec<Vec2> = alive.iter().map(|&i| from[i]).collect();
-    let backward = lk(next, prev, &there, Some(&back_guess), options.levels)?;
-    let mut result = vec![None; from.len()];
-    for (k, &i) in alive.iter().enumerate() {
-        if let Some(b) = backward[k]
-            && b.distance(from[i]) <= max_fb_error_px
-        {
-            result[i] = forward[i];
-        }
-    }
-    Ok(result)
+    crate::lk::forward_backward(from, forward, max_fb_error_px, |there, back_guess| {
+        lk(next, prev, there, Some(back_guess), levels)
+    })
 }
 
 /// Shi–Tomasi corners at least `min_distance_px` away from each other and from `existing`.

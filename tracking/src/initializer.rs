@@ -4,9 +4,10 @@
 //! meanwhile get their poses once the map exists (late poses).
 
 use crate::ba::{BaObservation, bundle_adjust, refine_pose, reprojection_error_px};
-use crate::cv::{self, Pyramid};
+use crate::cv;
 use crate::features::{Track, normalized, parallax_rad, triangulate};
 use crate::frame::{Frame, TrackingState};
+use crate::lk::{self, Pyramid};
 use crate::map::Observation;
 use crate::pose::Se3;
 use crate::tracker::{LatePose, Tracker, TrackerError};
@@ -39,7 +40,7 @@ impl Tracker {
         }
         self.init = Some(Initializer {
             frame_index: frame.index,
-            pyramid: Pyramid::build(&frame.image)?,
+            pyramid: Pyramid::build(&frame.image),
             current: corners.iter().copied().map(Some).collect(),
             reference: corners,
             history: Vec::new(),
@@ -63,16 +64,16 @@ impl Tracker {
             .filter(|&i| init.current[i].is_some())
             .collect();
         let from: Vec<Vec2> = alive.iter().filter_map(|&i| init.current[i]).collect();
-        let moved = cv::track_points(
+        let moved = lk::track_points(
             &init.prev_pyramid,
             &pyramid,
             &from,
             None,
-            cv::LkOptions {
+            lk::LkOptions {
                 levels: self.config.lk_levels,
                 max_fb_error_px: Some(self.config.max_fb_error_px),
             },
-        )?;
+        );
         for (k, &i) in alive.iter().enumerate() {
             init.current[i] = moved[k].filter(|p| self.camera.contains(p.as_dvec2(), 2.0));
         }

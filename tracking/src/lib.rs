@@ -18,6 +18,7 @@ pub mod features;
 pub mod frame;
 pub mod ground_plane;
 pub mod linalg;
+pub mod lk;
 pub mod map;
 pub mod metrics;
 pub mod pose;

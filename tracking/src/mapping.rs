@@ -3,9 +3,10 @@
 //! keyframe that saw each point, and local bundle adjustment over recent keyframes.
 
 use crate::ba::{BaObservation, bundle_adjust, reprojection_error_px};
-use crate::cv::{self, Pyramid};
+use crate::cv;
 use crate::features::{Track, TrackOrigin, normalized, parallax_rad, triangulate};
 use crate::frame::{Frame, GrayImage};
+use crate::lk::{self, Pyramid};
 use crate::map::Observation;
 use crate::pose::Se3;
 use crate::tracker::{Tracker, TrackerError};
@@ -62,9 +63,8 @@ impl Tracker {
         self.local_bundle_adjustment(kf);
         self.add_candidates(frame, kf)?;
         self.describe_keyframe_points(kf, &frame.image);
-        if let Some(pyramid) = self.prev_pyramid.take() {
-            self.keyframe_pyramids.insert(kf, pyramid);
-            self.prev_pyramid = Some(Pyramid::build(&frame.image)?);
+        if let Some(pyramid) = &self.prev_pyramid {
+            self.keyframe_pyramids.insert(kf, pyramid.clone());
         }
         if self.keyframe_pyramids.len() > MAX_KEYFRAME_PYRAMIDS {
             let oldest = self.keyframe_pyramids.keys().copied().min();
@@ -246,19 +246,19 @@ impl Tracker {
             };
             let from: Vec<Vec2> = list.iter().map(|l| l.1).collect();
             let guess: Vec<Vec2> = list.iter().map(|l| l.2).collect();
-            let found = cv::track_points(
+            let found = lk::track_points(
                 kf_pyramid,
                 pyramid,
                 &from,
                 Some(&guess),
-                cv::LkOptions {
+                lk::LkOptions {
                     levels: self.config.search_lk_levels,
                     max_fb_error_px: self
                         .config
                         .search_fb_check
                         .then_some(self.config.max_fb_error_px),
                 },
-            )?;
+            );
             for ((id, _, projected), pixel) in list.into_iter().zip(found) {
                 if let Some(pixel) = pixel.filter(|p| p.distance(projected) < 6.0) {
                     self.tracks.push(Track {

@@ -5,10 +5,11 @@
 
 use crate::ba::{BaConfig, refine_pose, reprojection_error_px};
 use crate::camera::Camera;
-use crate::cv::{self, CvError, OrbFeatures, Pyramid};
+use crate::cv::{self, CvError, OrbFeatures};
 use crate::features::{Track, normalized};
 use crate::frame::{Frame, FrameOutput, Plane, TrackedPoint, TrackingState};
 use crate::initializer::Initializer;
+use crate::lk::{self, Pyramid};
 use crate::map::Map;
 use crate::pose::Se3;
 use crate::world::WorldFrame;
@@ -32,10 +33,10 @@ pub struct TrackerConfig {
     /// Forward-backward Lucas–Kanade tolerance, pixels. Default 2.0.
     pub max_fb_error_px: f32,
     /// Pyramid levels above the base for frame-to-frame tracks. Default 3.
-    pub lk_levels: i32,
+    pub lk_levels: usize,
     /// Pyramid levels above the base for the local-map search, seeded at projections through
-    /// the frame's pose (a guess within a few pixels). Default 3.
-    pub search_lk_levels: i32,
+    /// the frame's pose (a guess within a few pixels). Default 1.
+    pub search_lk_levels: usize,
     /// Whether the local-map search checks matches forward-backward; its reprojection gate
     /// rejects wrong matches either way. Default true.
     pub search_fb_check: bool,
@@ -64,7 +65,7 @@ pub struct TrackerConfig {
     pub min_pose_inliers: usize,
     /// Keyframes optimised by local bundle adjustment. Default 8.
     pub local_window: usize,
-    /// Map points searched by reprojection per frame at most. Default 150.
+    /// Map points searched by reprojection per frame at most. Default 400.
     pub max_local_search: usize,
     /// A keyframe at least every this many frames. Default 8.
     pub max_keyframe_gap: usize,
@@ -81,7 +82,7 @@ impl Default for TrackerConfig {
             min_corner_distance_px: 14.0,
             max_fb_error_px: 2.0,
             lk_levels: 3,
-            search_lk_levels: 3,
+            search_lk_levels: 1,
             search_fb_check: true,
             outlier_px: 4.0,
             huber_px: 1.5,
@@ -93,7 +94,7 @@ impl Default for TrackerConfig {
             init_min_points: 80,
             min_pose_inliers: 12,
             local_window: 8,
-            max_local_search: 150,
+            max_local_search: 400,
             max_keyframe_gap: 8,
             lost_after_frames: 30,
             holding_height_m: crate::scale::DEFAULT_HOLDING_HEIGHT_M,
@@ -189,7 +190,7 @@ impl Tracker {
             self.gravity_up = Some(a.normalize());
         }
         let blank = frame.image.contrast() < 4.0;
-        let pyramid = Pyramid::build(&frame.image)?;
+        let pyramid = Pyramid::build(&frame.image);
         let pose = match self.state {
             TrackingState::NotInitialized | TrackingState::Initializing if blank => None,
             TrackingState::NotInitialized => {
@@ -268,16 +269,16 @@ impl Tracker {
             .map(|t| self.predict_pixel(t, &prev_pose, &predicted))
             .collect();
         let from: Vec<Vec2> = self.tracks.iter().map(|t| t.pixel).collect();
-        let moved = cv::track_points(
+        let moved = lk::track_points(
             prev_pyramid,
             pyramid,
             &from,
             Some(&guesses),
-            cv::LkOptions {
+            lk::LkOptions {
                 levels: self.config.lk_levels,
                 max_fb_error_px: Some(self.config.max_fb_error_px),
             },
-        )?;
+        );
         let mut kept = Vec::with_capacity(self.tracks.len());
         for (track, next) in self.tracks.iter().zip(moved) {
             if let Some(pixel) = next.filter(|p| self.camera.contains(p.as_dvec2(), 2.0)) {
