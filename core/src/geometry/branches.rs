@@ -5,7 +5,7 @@
 
 use std::f32::consts::{PI, TAU};
 
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 
 use super::lanes::V4;
 use super::parent_tube::{ParentTube, onto_parent, onto_parent4};
@@ -318,12 +318,14 @@ impl RingFrames {
         let first_vertex = mesh.positions.len();
         // Every attribute is appended from an iterator of known length, written once in place.
         for ring in rings {
-            let (reference, binormal) = (ring.reference, ring.binormal);
+            // In SIMD vectors (`Vec3A`): the same operations lane by lane, so the same bits.
+            let (reference, binormal) = (Vec3A::from(ring.reference), Vec3A::from(ring.binormal));
+            let center = Vec3A::from(ring.center);
             let direction = |&(cos, sin): &(f32, f32)| reference * cos + binormal * sin;
             mesh.positions.extend(
                 table
                     .iter()
-                    .map(|cs| (ring.center + direction(cs) * ring.radius).to_array()),
+                    .map(|cs| (center + direction(cs) * ring.radius).to_array()),
             );
             mesh.normals
                 .extend(table.iter().map(|cs| direction(cs).to_array()));

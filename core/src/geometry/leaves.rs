@@ -11,7 +11,7 @@
 //! The leaf buffer is in random order, so a prefix of it is an even thinning of the crown: the
 //! levels of detail draw prefixes.
 
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 use serde::{Deserialize, Serialize};
 
 use super::petiole::{Attachment, Blade, Petiole};
@@ -175,17 +175,20 @@ pub(crate) fn build_leaves_into(
         let up = heading.cross(left);
         let first_leaf = slots.len();
         spiral.extend_to(first_leaf + count as usize);
+        // In SIMD vectors (`Vec3A`): glam's `Vec3` operations lane by lane, the same bits.
+        let (left, up) = (Vec3A::from(left), Vec3A::from(up));
+        let (start, end) = (Vec3A::from(node.start), Vec3A::from(node.end));
         for (k, &(cos, sin)) in spiral.turns[first_leaf..][..count as usize]
             .iter()
             .enumerate()
         {
             let radial = left * cos + up * sin;
             let along = (k as f32 + 0.5) / count as f32;
-            let attachment = node.start.lerp(node.end, along) + radial * (0.5 * node.diameter);
+            let attachment = start.lerp(end, along) + radial * (0.5 * node.diameter);
             let slot = Attachment {
-                point: attachment,
+                point: attachment.into(),
                 heading,
-                radial,
+                radial: radial.into(),
                 light: 0.0,
             };
             slots.push(slot);

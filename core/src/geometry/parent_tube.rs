@@ -5,8 +5,8 @@
 use glam::{Vec3, Vec4};
 
 use super::NodeGeom;
-use super::rings::Ring;
 use super::lanes::V4;
+use super::rings::Ring;
 use super::topology::{BranchTopology, NONE};
 
 /// Radius of the parent's tube at the ends of internode `node`, as the rings draw it.
