@@ -111,17 +111,13 @@ pub(crate) struct Scratch {
     pub in_mask: Vec<bool>,
     pub acc: Vec<f64>,
     pub subtree_root: Vec<u32>,
-    /// The arena's links as [`buds::collect`] found them, compact for the passes that follow
-    /// before the arena changes (vigor, shedding): parent and main child of node i
-    /// ([`NO_NODE`] for none), and its lateral children
-    /// `lateral[lateral_start[i]..lateral_start[i + 1]]` in order.
-    pub parent: Vec<u32>,
+    /// The arena's links as the basipetal vigor pass reads them, compact for the passes that
+    /// follow before the arena changes (acropetal vigor, shedding): main child of node i
+    /// ([`NO_NODE`] for none) and its lateral children
+    /// `lateral[lateral_range[i].0..lateral_range[i].1]` in order.
     pub main_child: Vec<u32>,
-    pub lateral_start: Vec<u32>,
+    pub lateral_range: Vec<(u32, u32)>,
     pub lateral: Vec<u32>,
-    /// Start and end of every internode as collect found them (occupancy, gravimorphism).
-    pub node_start: Vec<Vec3>,
-    pub node_end: Vec<Vec3>,
 }
 
 /// No node, in [`Scratch`]'s compact links.
@@ -242,7 +238,7 @@ impl Tree {
         } else {
             Vec::new()
         };
-        let removed = subtree_flags(&scratch.parent, &shed);
+        let removed = subtree_flags(&scratch, &shed);
         let grown = shoots::grow_all(self, &mut scratch, v_max, &removed, options.scene);
         stats.num_shoots = grown.0;
         stats.num_new_internodes = grown.1;
@@ -399,19 +395,29 @@ impl Tree {
     }
 }
 
-/// [`crate::tree::Skeleton::subtree_flags`] from the compact parent links of the arena.
-fn subtree_flags(parent: &[u32], roots: &[NodeId]) -> Vec<bool> {
-    let mut flags = vec![false; parent.len()];
+/// [`crate::tree::Skeleton::subtree_flags`] from the compact links of the arena: children come
+/// after their parent, so one forward pass hands the flags down.
+fn subtree_flags(scratch: &Scratch, roots: &[NodeId]) -> Vec<bool> {
+    let n = scratch.main_child.len();
+    let mut flags = vec![false; n];
+    if roots.is_empty() {
+        return flags;
+    }
     for r in roots {
         if let Some(f) = flags.get_mut(r.index()) {
             *f = true;
         }
     }
-    for i in 0..parent.len() {
-        if let Some(&p) = flags.get(parent[i] as usize)
-            && p
-        {
-            flags[i] = true;
+    for i in 0..n {
+        if !flags[i] {
+            continue;
+        }
+        let (start, end) = scratch.lateral_range[i];
+        let laterals = &scratch.lateral[start as usize..end as usize];
+        for &c in std::iter::once(&scratch.main_child[i]).chain(laterals) {
+            if let Some(f) = flags.get_mut(c as usize) {
+                *f = true;
+            }
         }
     }
     flags

@@ -4,7 +4,7 @@
 
 use glam::Vec3;
 
-use super::{NO_NODE, Scratch, Tree};
+use super::{Scratch, Tree};
 use crate::species::{Phyllotaxis, Species};
 use crate::tree::Internode;
 
@@ -56,12 +56,6 @@ pub(crate) fn collect(tree: &mut Tree, scratch: &mut Scratch) {
     let nodes = &mut tree.skeleton.internodes;
     scratch.buds.clear();
     scratch.node_bud_start.clear();
-    scratch.parent.clear();
-    scratch.main_child.clear();
-    scratch.lateral_start.clear();
-    scratch.lateral.clear();
-    scratch.node_start.clear();
-    scratch.node_end.clear();
     scratch.in_mask.clear();
     scratch
         .in_mask
@@ -85,16 +79,6 @@ pub(crate) fn collect(tree: &mut Tree, scratch: &mut Scratch) {
                 bud.alive = false;
             }
         }
-        scratch.node_start.push(node.start);
-        scratch.node_end.push(node.end);
-        scratch.parent.push(node.parent.map_or(NO_NODE, |p| p.0));
-        scratch
-            .main_child
-            .push(node.main_child.map_or(NO_NODE, |c| c.0));
-        scratch.lateral_start.push(scratch.lateral.len() as u32);
-        scratch
-            .lateral
-            .extend(node.lateral_children.iter().map(|c| c.0));
         let first = scratch.buds.len();
         scratch.node_bud_start.push(first as u32);
         let may_grow = scratch.in_mask[i];
@@ -134,7 +118,6 @@ pub(crate) fn collect(tree: &mut Tree, scratch: &mut Scratch) {
         }
     }
     scratch.node_bud_start.push(scratch.buds.len() as u32);
-    scratch.lateral_start.push(scratch.lateral.len() as u32);
 }
 
 /// Azimuth turn between successive nodes of an axis.

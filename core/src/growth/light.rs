@@ -17,7 +17,7 @@ pub(crate) fn exposure(s: &Species, shadow: &ShadowGrid, node_end: Vec3) -> f32 
 /// Q = b·L^κ for enabled buds (0 for the others).
 pub(crate) fn bud_input(tree: &Tree, scratch: &mut Scratch) {
     let s = &tree.species;
-    let (starts, ends) = (&scratch.node_start, &scratch.node_end);
+    let nodes = &tree.skeleton.internodes;
     for bud in &mut scratch.buds {
         if !bud.enabled {
             bud.q = 0.0;
@@ -26,12 +26,11 @@ pub(crate) fn bud_input(tree: &Tree, scratch: &mut Scratch) {
         let b = if bud.slot == TERMINAL {
             1.0
         } else {
-            // H of the parent internode, as `Internode::heading` computes it.
-            let node = bud.node as usize;
-            let heading = (ends[node] - starts[node])
-                .try_normalize()
-                .unwrap_or(Vec3::Y);
-            gravimorphism(&s.gravimorphism, heading, bud.direction)
+            gravimorphism(
+                &s.gravimorphism,
+                nodes[bud.node as usize].heading(),
+                bud.direction,
+            )
         };
         bud.q = b * bud.light.powf(s.light_sensitivity);
     }

@@ -70,9 +70,13 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
     };
     // Occupancy: every node (internode end) holds buds or did; its sphere takes points away.
     scratch.positions.clear();
-    scratch
-        .positions
-        .extend(scratch.node_end.iter().copied().filter(|&e| near(e, r)));
+    scratch.positions.extend(
+        tree.skeleton
+            .internodes
+            .iter()
+            .map(|n| n.end)
+            .filter(|&e| near(e, r)),
+    );
     scratch.node_grid.rebuild(&scratch.positions, r);
     // The point grid serves the shoots later (perception, consumption); built now, its cell
     // order also orders the queries below so that neighbouring queries share cached cells.

@@ -10,10 +10,12 @@ use super::buds::TERMINAL;
 use super::{NO_NODE, Scratch, Tree};
 use crate::tree::NodeId;
 
-/// Runs both passes; returns v_max, the largest vigor of an enabled bud (0 if none). The links
-/// come from the compact copy that [`super::buds::collect`] took of the arena.
+/// Runs both passes; returns v_max, the largest vigor of an enabled bud (0 if none). The
+/// basipetal pass also takes the compact copy of the arena's links (see [`Scratch`]) that the
+/// acropetal pass and shedding use.
 pub(crate) fn distribute(tree: &Tree, scratch: &mut Scratch) -> f32 {
-    let n = tree.skeleton.internodes.len();
+    let nodes = &tree.skeleton.internodes;
+    let n = nodes.len();
     let lambda = tree.species.apical_dominance;
     let Scratch {
         buds,
@@ -23,20 +25,21 @@ pub(crate) fn distribute(tree: &Tree, scratch: &mut Scratch) -> f32 {
         vigor,
         size,
         main_child,
-        lateral_start,
+        lateral_range,
         lateral,
         ..
     } = scratch;
-    q_main.clear();
+    // The basipetal pass writes every entry of these before it reads it.
+    main_child.resize(n, NO_NODE);
+    lateral_range.resize(n, (0, 0));
     q_main.resize(n, 0.0);
-    q_lateral.clear();
     q_lateral.resize(n, 0.0);
+    size.resize(n, 1);
+    lateral.clear();
     vigor.clear();
     vigor.resize(n, 0.0);
-    size.clear();
-    size.resize(n, 1);
-    let laterals = |i: usize| &lateral[lateral_start[i] as usize..lateral_start[i + 1] as usize];
     for i in (0..n).rev() {
+        let node = &nodes[i];
         let (mut qm, mut ql) = (0.0, 0.0);
         for bud in &buds[node_bud_start[i] as usize..node_bud_start[i + 1] as usize] {
             if bud.slot == TERMINAL {
@@ -46,16 +49,20 @@ pub(crate) fn distribute(tree: &Tree, scratch: &mut Scratch) -> f32 {
             }
         }
         let mut s = 1;
-        if main_child[i] != NO_NODE {
-            let c = main_child[i] as usize;
+        main_child[i] = node.main_child.map_or(NO_NODE, |c| c.0);
+        if let Some(c) = node.main_child {
+            let c = c.index();
             qm += q_main[c] + q_lateral[c];
             s += size[c];
         }
-        for &c in laterals(i) {
-            let c = c as usize;
+        let start = lateral.len() as u32;
+        for &c in &node.lateral_children {
+            lateral.push(c.0);
+            let c = c.index();
             ql += q_main[c] + q_lateral[c];
             s += size[c];
         }
+        lateral_range[i] = (start, lateral.len() as u32);
         q_main[i] = qm;
         q_lateral[i] = ql;
         size[i] = s;
@@ -63,6 +70,10 @@ pub(crate) fn distribute(tree: &Tree, scratch: &mut Scratch) -> f32 {
     if n > 0 {
         vigor[0] = q_main[0] + q_lateral[0];
     }
+    let laterals = |i: usize| {
+        let (start, end) = lateral_range[i];
+        &lateral[start as usize..end as usize]
+    };
     let mut v_max = 0.0f32;
     for i in 0..n {
         let (qm, ql) = (q_main[i], q_lateral[i]);
@@ -111,8 +122,9 @@ pub(crate) fn select_shed(tree: &Tree, scratch: &mut Scratch, v_max: f32) -> Vec
     let scale = super::shoots::max_shoot_internodes(tree) / v_max;
     // Every lateral child of every node, in node order.
     scratch
-        .lateral
+        .lateral_range
         .iter()
+        .flat_map(|&(start, end)| &scratch.lateral[start as usize..end as usize])
         .map(|&c| c as usize)
         .filter(|&c| {
             let ratio = scratch.vigor[c] * scale / scratch.size[c] as f32;
