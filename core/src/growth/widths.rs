@@ -67,30 +67,53 @@ pub(crate) fn update(
 ) {
     let nodes = &mut skeleton.internodes;
     let n = nodes.len();
+    exponents.clear();
+    exponents.resize(n, default_exponent);
+    // Without width constraints (the usual case) the whole tree is the root's subtree with the
+    // species exponent: one basipetal pass, given up at the first constrained internode.
+    if basipetal(nodes, None, exponents, tip_diameter, &mut scratch.acc) {
+        return;
+    }
     let roots = &mut scratch.subtree_root;
     roots.clear();
     roots.resize(n, 0);
-    let mut any_constraint = false;
     for i in 0..n {
         let constrained = nodes[i].width_constraint.is_some();
-        any_constraint |= constrained;
         roots[i] = match nodes[i].parent {
             Some(p) if !constrained => roots[p.index()],
             _ => i as u32,
         };
     }
-    exponents.clear();
-    exponents.resize(n, default_exponent);
-    if any_constraint {
-        solve_subtree_exponents(nodes, roots, tip_diameter, default_exponent, exponents);
-    }
-    // Basipetal: acc[i] = Σ over children of d_c^{n_i}; d_i = acc^{1/n_i}.
-    let acc = &mut scratch.acc;
+    solve_subtree_exponents(nodes, roots, tip_diameter, default_exponent, exponents);
+    basipetal(
+        nodes,
+        Some(roots),
+        exponents,
+        tip_diameter,
+        &mut scratch.acc,
+    );
+}
+
+/// The basipetal pass: acc[i] = Σ over children of d_c^{n_i}; d_i = acc^{1/n_i}. `roots` gives
+/// each internode's subtree; `None` means one subtree for all, and then the pass stops (false)
+/// at the first width constraint.
+fn basipetal(
+    nodes: &mut [crate::tree::Internode],
+    roots: Option<&[u32]>,
+    exponents: &[f32],
+    tip_diameter: f32,
+    acc: &mut Vec<f64>,
+) -> bool {
+    let n = nodes.len();
+    let same_subtree = |a: usize, b: usize| roots.is_none_or(|r| r[a] == r[b]);
     acc.clear();
     acc.resize(n, 0.0);
     // d_e^n of a tip, for the last exponent seen (almost always the same one).
     let mut tip_mass = (f64::NAN, 0.0);
     for i in (0..n).rev() {
+        if roots.is_none() && nodes[i].width_constraint.is_some() {
+            return false;
+        }
         let exponent = f64::from(exponents[i]);
         // A node whose only child is an unconstrained inner node of its own subtree sums that
         // child's mass alone (0 + m = m exactly), so its diameter is the child's: no power.
@@ -100,7 +123,7 @@ pub(crate) fn update(
                 let c = c.index();
                 (child.width_constraint.is_none()
                     && !child.is_tip()
-                    && roots[c] == roots[i]
+                    && same_subtree(c, i)
                     && exponents[c] == exponents[i])
                     .then_some(child.diameter)
             }
@@ -121,13 +144,14 @@ pub(crate) fn update(
         node.diameter = diameter;
         if let Some(p) = node.parent {
             let p = p.index();
-            acc[p] += if roots[i] == roots[p] {
+            acc[p] += if same_subtree(i, p) {
                 mass
             } else {
                 f64::from(diameter).powf(f64::from(exponents[p]))
             };
         }
     }
+    true
 }
 
 fn solve_subtree_exponents(
