@@ -25,6 +25,10 @@ const HALF: usize = WINDOW / 2;
 const PAD: usize = HALF + 3;
 /// Side of the template patch sampled with its one-pixel gradient border.
 const OUTER: usize = WINDOW + 2;
+/// Rows are computed in whole lanes: this many samples per row (the extra ones land where the
+/// next row then writes, or in the zero tail), read from this many more columns of each level.
+const ROW: usize = OUTER.div_ceil(LANES) * LANES;
+const SLACK: usize = ROW - WINDOW;
 const AREA: usize = WINDOW * WINDOW;
 /// Samples of a window rounded up to whole lanes.
 const LANES: usize = 8;
@@ -142,7 +146,7 @@ fn pyr_down(src: &[f32], width: usize, height: usize) -> (Vec<f32>, usize, usize
 
 impl Level {
     fn new(pixels: &[f32], width: usize, height: usize) -> Self {
-        let stride = width + 2 * PAD;
+        let stride = width + 2 * PAD + SLACK;
         let rows = height + 2 * PAD;
         let mut image = vec![0.0f32; stride * rows];
         for y in 0..rows {
@@ -171,7 +175,7 @@ impl Level {
             return None;
         }
         let (ix, iy) = (fx as isize + PAD as isize, fy as isize + PAD as isize);
-        let limit_x = (self.stride - side - 1) as isize;
+        let limit_x = (self.stride - SLACK - side - 1) as isize;
         let limit_y = (self.height + 2 * PAD - side - 1) as isize;
         if ix < 0 || iy < 0 || ix > limit_x || iy > limit_y {
             return None;
@@ -182,8 +186,9 @@ impl Level {
     }
 }
 
-/// Bilinear samples of a `side`-pixel window of `plane` starting at `start` into `out`
-/// (row-major, `side` per row).
+/// Bilinear samples of a `SIDE`-pixel window of `plane` starting at `start` into `out`
+/// (row-major, `SIDE` per row). Each row is computed [`ROW`] wide, the samples past `SIDE`
+/// overwritten by the next row, so `out` holds `ROW − SIDE` floats of slack.
 #[inline(always)]
 fn sample<const SIDE: usize>(
     plane: &[f32],
@@ -193,59 +198,178 @@ fn sample<const SIDE: usize>(
     out: &mut [f32],
 ) {
     for r in 0..SIDE {
-        let top = &plane[start + r * stride..start + r * stride + SIDE + 1];
-        let bottom = &plane[start + (r + 1) * stride..start + (r + 1) * stride + SIDE + 1];
-        let row = &mut out[r * SIDE..(r + 1) * SIDE];
-        for c in 0..SIDE {
+        let top = &plane[start + r * stride..][..ROW + 1];
+        let bottom = &plane[start + (r + 1) * stride..][..ROW + 1];
+        let row = &mut out[r * SIDE..][..ROW];
+        for c in 0..ROW {
             row[c] = w[0] * top[c] + w[1] * top[c + 1] + w[2] * bottom[c] + w[3] * bottom[c + 1];
         }
     }
 }
 
-/// The template (centre of `outer`) and its Scharr gradients, (3 10 3) across and (−1 0 1)
-/// along, over 32: grey levels per pixel.
-#[inline(always)]
-fn template_and_gradients(outer: &[f32], t: &mut Patch, gx: &mut Patch, gy: &mut Patch) {
-    let (t, gx, gy) = (
-        t.as_flattened_mut(),
-        gx.as_flattened_mut(),
-        gy.as_flattened_mut(),
-    );
-    for r in 0..WINDOW {
-        let up = &outer[r * OUTER..(r + 1) * OUTER];
-        let mid = &outer[(r + 1) * OUTER..(r + 2) * OUTER];
-        let down = &outer[(r + 2) * OUTER..(r + 3) * OUTER];
-        let o = r * WINDOW;
-        for c in 0..WINDOW {
-            t[o + c] = mid[c + 1];
-            gx[o + c] = (3.0 * (up[c + 2] - up[c])
-                + 10.0 * (mid[c + 2] - mid[c])
-                + 3.0 * (down[c + 2] - down[c]))
-                * (1.0 / 32.0);
-            gy[o + c] = (3.0 * (down[c] - up[c])
-                + 10.0 * (down[c + 1] - up[c + 1])
-                + 3.0 * (down[c + 2] - up[c + 2]))
-                * (1.0 / 32.0);
+/// The vector kernels of a solve. [`Portable`] is plain code the compiler vectorises as the
+/// target allows; [`Avx2`] spells the same operations, in the same order, with AVX2 intrinsics.
+/// Both give bit-identical results.
+trait Kernel {
+    /// Σ a·b over the window, in eight fixed lanes.
+    fn dot(a: &Patch, b: &Patch) -> f32;
+
+    /// The template (centre of `outer`, a patch of side [`OUTER`]) and its Scharr gradients,
+    /// (3 10 3) across and (−1 0 1) along, over 32: grey levels per pixel. The tails past the
+    /// window stay zero.
+    fn gradients(outer: &[f32], t: &mut Patch, gx: &mut Patch, gy: &mut Patch);
+
+    /// Σ j·gx and Σ j·gy over the window.
+    #[inline(always)]
+    fn dot2(j: &Patch, gx: &Patch, gy: &Patch) -> (f32, f32) {
+        (Self::dot(j, gx), Self::dot(j, gy))
+    }
+}
+
+struct Portable;
+
+impl Kernel for Portable {
+    #[inline(always)]
+    fn dot(a: &Patch, b: &Patch) -> f32 {
+        let mut acc = [0.0f32; LANES];
+        for c in 0..CHUNKS {
+            for l in 0..LANES {
+                acc[l] += a[c][l] * b[c][l];
+            }
+        }
+        lane_sum(acc)
+    }
+
+    #[inline(always)]
+    fn gradients(outer: &[f32], t: &mut Patch, gx: &mut Patch, gy: &mut Patch) {
+        let (t, gx, gy) = (
+            t.as_flattened_mut(),
+            gx.as_flattened_mut(),
+            gy.as_flattened_mut(),
+        );
+        for r in 0..WINDOW {
+            let up = &outer[r * OUTER..][..ROW + 2];
+            let mid = &outer[(r + 1) * OUTER..][..ROW + 2];
+            let down = &outer[(r + 2) * OUTER..][..ROW + 2];
+            let (t, gx, gy) = (
+                &mut t[r * WINDOW..][..ROW],
+                &mut gx[r * WINDOW..][..ROW],
+                &mut gy[r * WINDOW..][..ROW],
+            );
+            for c in 0..ROW {
+                t[c] = mid[c + 1];
+                gx[c] = (3.0 * (up[c + 2] - up[c])
+                    + 10.0 * (mid[c + 2] - mid[c])
+                    + 3.0 * (down[c + 2] - down[c]))
+                    * (1.0 / 32.0);
+                gy[c] = (3.0 * (down[c] - up[c])
+                    + 10.0 * (down[c + 1] - up[c + 1])
+                    + 3.0 * (down[c + 2] - up[c + 2]))
+                    * (1.0 / 32.0);
+            }
+        }
+        // The last row's extra samples fall in the tail, which must stay zero.
+        for plane in [t, gx, gy] {
+            plane[AREA..].fill(0.0);
         }
     }
 }
 
-/// Σ a·b over the window, in eight fixed lanes.
-#[inline(always)]
-fn dot(a: &Patch, b: &Patch) -> f32 {
-    let mut acc = [0.0f32; LANES];
-    for c in 0..CHUNKS {
-        for l in 0..LANES {
-            acc[l] += a[c][l] * b[c][l];
-        }
+#[cfg(target_arch = "x86_64")]
+struct Avx2;
+
+#[cfg(target_arch = "x86_64")]
+impl Kernel for Avx2 {
+    #[inline(always)]
+    fn dot(a: &Patch, b: &Patch) -> f32 {
+        // SAFETY: `Avx2` is only used by `track_all_avx2`, called once AVX2 was detected.
+        unsafe { avx2::dot(a, b) }
     }
-    lane_sum(acc)
+
+    #[inline(always)]
+    fn gradients(outer: &[f32], t: &mut Patch, gx: &mut Patch, gy: &mut Patch) {
+        // SAFETY: as for `dot`.
+        unsafe { avx2::gradients(outer, t, gx, gy) }
+    }
 }
 
-/// Σ j·gx and Σ j·gy over the window.
-#[inline(always)]
-fn dot2(j: &Patch, gx: &Patch, gy: &Patch) -> (f32, f32) {
-    (dot(j, gx), dot(j, gy))
+#[cfg(target_arch = "x86_64")]
+mod avx2 {
+    use super::{AREA, CHUNKS, OUTER, Patch, ROW, WINDOW, lane_sum};
+    use std::arch::x86_64::*;
+
+    #[target_feature(enable = "avx2")]
+    pub(super) fn dot(a: &Patch, b: &Patch) -> f32 {
+        let mut acc = _mm256_setzero_ps();
+        for c in 0..CHUNKS {
+            // SAFETY: each chunk is eight floats.
+            let (x, y) = unsafe {
+                (
+                    _mm256_loadu_ps(a[c].as_ptr()),
+                    _mm256_loadu_ps(b[c].as_ptr()),
+                )
+            };
+            acc = _mm256_add_ps(acc, _mm256_mul_ps(x, y));
+        }
+        let mut lanes = [0.0f32; 8];
+        // SAFETY: `lanes` holds eight floats.
+        unsafe { _mm256_storeu_ps(lanes.as_mut_ptr(), acc) };
+        lane_sum(lanes)
+    }
+
+    #[target_feature(enable = "avx2")]
+    pub(super) fn gradients(outer: &[f32], t: &mut Patch, gx: &mut Patch, gy: &mut Patch) {
+        let (t, gx, gy) = (
+            t.as_flattened_mut(),
+            gx.as_flattened_mut(),
+            gy.as_flattened_mut(),
+        );
+        let (three, ten, scale) = (
+            _mm256_set1_ps(3.0),
+            _mm256_set1_ps(10.0),
+            _mm256_set1_ps(1.0 / 32.0),
+        );
+        for r in 0..WINDOW {
+            let up = &outer[r * OUTER..][..ROW + 2];
+            let mid = &outer[(r + 1) * OUTER..][..ROW + 2];
+            let down = &outer[(r + 2) * OUTER..][..ROW + 2];
+            let (t, gx, gy) = (
+                &mut t[r * WINDOW..][..ROW],
+                &mut gx[r * WINDOW..][..ROW],
+                &mut gy[r * WINDOW..][..ROW],
+            );
+            for c in (0..ROW).step_by(8) {
+                // SAFETY: the rows hold ROW + 2 floats and the outputs ROW, so every load of
+                // eight at c, c + 1 or c + 2 and every store at c is in bounds.
+                unsafe {
+                    let load = |row: &[f32], k: usize| _mm256_loadu_ps(row.as_ptr().add(c + k));
+                    let (u0, u1, u2) = (load(up, 0), load(up, 1), load(up, 2));
+                    let (m0, m1, m2) = (load(mid, 0), load(mid, 1), load(mid, 2));
+                    let (d0, d1, d2) = (load(down, 0), load(down, 1), load(down, 2));
+                    let x = _mm256_add_ps(
+                        _mm256_add_ps(
+                            _mm256_mul_ps(three, _mm256_sub_ps(u2, u0)),
+                            _mm256_mul_ps(ten, _mm256_sub_ps(m2, m0)),
+                        ),
+                        _mm256_mul_ps(three, _mm256_sub_ps(d2, d0)),
+                    );
+                    let y = _mm256_add_ps(
+                        _mm256_add_ps(
+                            _mm256_mul_ps(three, _mm256_sub_ps(d0, u0)),
+                            _mm256_mul_ps(ten, _mm256_sub_ps(d1, u1)),
+                        ),
+                        _mm256_mul_ps(three, _mm256_sub_ps(d2, u2)),
+                    );
+                    _mm256_storeu_ps(t.as_mut_ptr().add(c), m1);
+                    _mm256_storeu_ps(gx.as_mut_ptr().add(c), _mm256_mul_ps(x, scale));
+                    _mm256_storeu_ps(gy.as_mut_ptr().add(c), _mm256_mul_ps(y, scale));
+                }
+            }
+        }
+        for plane in [t, gx, gy] {
+            plane[AREA..].fill(0.0);
+        }
+    }
 }
 
 #[inline(always)]
@@ -255,7 +379,7 @@ fn lane_sum(acc: [f32; LANES]) -> f32 {
 
 /// Working memory of one point's solve.
 struct Scratch {
-    outer: [f32; OUTER * OUTER],
+    outer: [f32; OUTER * OUTER + ROW],
     template: Patch,
     grad_x: Patch,
     grad_y: Patch,
@@ -265,7 +389,7 @@ struct Scratch {
 impl Scratch {
     fn new() -> Box<Self> {
         Box::new(Self {
-            outer: [0.0; OUTER * OUTER],
+            outer: [0.0; OUTER * OUTER + ROW],
             template: [[0.0; LANES]; CHUNKS],
             grad_x: [[0.0; LANES]; CHUNKS],
             grad_y: [[0.0; LANES]; CHUNKS],
@@ -276,7 +400,7 @@ impl Scratch {
 
 /// Where `from` (base pixels in `prev`) lies in `next`, starting the search at `guess`.
 #[inline(always)]
-fn track_one(
+fn track_one<K: Kernel>(
     prev: &Pyramid,
     next: &Pyramid,
     from: Vec2,
@@ -298,11 +422,11 @@ fn track_one(
             continue;
         };
         sample::<OUTER>(&lp.image, lp.stride, start, w, &mut s.outer);
-        template_and_gradients(&s.outer, &mut s.template, &mut s.grad_x, &mut s.grad_y);
+        K::gradients(&s.outer, &mut s.template, &mut s.grad_x, &mut s.grad_y);
         let (a11, a12, a22) = (
-            dot(&s.grad_x, &s.grad_x),
-            dot(&s.grad_x, &s.grad_y),
-            dot(&s.grad_y, &s.grad_y),
+            K::dot(&s.grad_x, &s.grad_x),
+            K::dot(&s.grad_x, &s.grad_y),
+            K::dot(&s.grad_y, &s.grad_y),
         );
         let min_eigen = (a11 + a22 - ((a11 - a22) * (a11 - a22) + 4.0 * a12 * a12).sqrt())
             / (2.0 * AREA as f32);
@@ -316,7 +440,7 @@ fn track_one(
         }
         let inv_det = 1.0 / det;
         // Σ (J − T)·∇T = Σ J·∇T − Σ T·∇T; the second sum is fixed for the level.
-        let (tx, ty) = dot2(&s.template, &s.grad_x, &s.grad_y);
+        let (tx, ty) = K::dot2(&s.template, &s.grad_x, &s.grad_y);
         let mut previous_step = Vec2::ZERO;
         for iteration in 0..MAX_ITERATIONS {
             let Some((start, w)) = ln.window(at + flow, WINDOW) else {
@@ -326,7 +450,7 @@ fn track_one(
                 break;
             };
             sample::<WINDOW>(&ln.image, ln.stride, start, w, s.moved.as_flattened_mut());
-            let (jx, jy) = dot2(&s.moved, &s.grad_x, &s.grad_y);
+            let (jx, jy) = K::dot2(&s.moved, &s.grad_x, &s.grad_y);
             let (bx, by) = (jx - tx, jy - ty);
             let step = Vec2::new(a12 * by - a22 * bx, a12 * bx - a11 * by) * inv_det;
             flow += step;
@@ -355,7 +479,7 @@ fn track_one(
 }
 
 #[inline(always)]
-fn track_all(
+fn track_all<K: Kernel>(
     prev: &Pyramid,
     next: &Pyramid,
     from: &[Vec2],
@@ -365,7 +489,7 @@ fn track_all(
     let mut scratch = Scratch::new();
     let mut found = Vec::with_capacity(from.len());
     for k in 0..from.len().min(guess.len()) {
-        found.push(track_one(
+        found.push(track_one::<K>(
             prev,
             next,
             from[k],
@@ -386,7 +510,7 @@ fn track_all_avx2(
     guess: &[Vec2],
     levels: usize,
 ) -> Vec<Option<Vec2>> {
-    track_all(prev, next, from, guess, levels)
+    track_all::<Avx2>(prev, next, from, guess, levels)
 }
 
 fn lk(
@@ -401,7 +525,7 @@ fn lk(
         // SAFETY: the CPU supports AVX2 (checked just above).
         return unsafe { track_all_avx2(prev, next, from, guess, levels) };
     }
-    track_all(prev, next, from, guess, levels)
+    track_all::<Portable>(prev, next, from, guess, levels)
 }
 
 /// Pyramidal Lucas–Kanade from `prev` to `next`, optionally with a forward-backward check.
@@ -594,7 +718,7 @@ mod tests {
         let prev = Pyramid::build(&texture(320, 240, Vec2::ZERO));
         let next = Pyramid::build(&texture(320, 240, Vec2::new(5.7, -3.2)));
         let from = grid();
-        let portable = track_all(&prev, &next, &from, &from, 3);
+        let portable = track_all::<Portable>(&prev, &next, &from, &from, 3);
         assert!(portable.iter().all(Option::is_some));
         #[cfg(target_arch = "x86_64")]
         if std::is_x86_feature_detected!("avx2") {
