@@ -229,10 +229,9 @@ impl Tree {
         let mut scratch = std::mem::take(&mut self.scratch);
         buds::collect(self, &mut scratch);
         stats.num_points = space::colonize(self, &mut scratch, options);
-        light::bud_input(self, &mut scratch);
+        stats.num_enabled_buds = light::bud_input(self, &mut scratch);
         let v_max = vigor::distribute(self, &mut scratch);
         stats.num_buds = scratch.buds.len();
-        stats.num_enabled_buds = scratch.buds.iter().filter(|b| b.enabled).count();
         let shed = if options.autonomous && v_max > 0.0 {
             vigor::select_shed(self, &mut scratch, v_max)
         } else {

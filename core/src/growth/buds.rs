@@ -71,6 +71,7 @@ pub(crate) fn collect(tree: &mut Tree, scratch: &mut Scratch) {
         }
     }
     let (species, shadow) = (&tree.species, &tree.environment.shadow);
+    let light_matters = species.light_sensitivity > 0.0;
     for (i, node) in nodes.iter_mut().enumerate() {
         if cutoff.is_some_and(|c| node.born_iteration < c)
             && node.lateral_buds.iter().any(|b| b.alive)
@@ -112,8 +113,12 @@ pub(crate) fn collect(tree: &mut Tree, scratch: &mut Scratch) {
         if scratch.buds.len() > first {
             let light = super::light::exposure(species, shadow, node.end);
             node.light_exposure = light;
+            // A bud in full shade (L = 0) can never grow when κ > 0 (Q = b·0^κ = 0): it takes
+            // no part in the competition for space ([`super::space`]).
+            let lit = !light_matters || light > 0.0;
             for bud in &mut scratch.buds[first..] {
                 bud.light = light;
+                bud.competes = bud.may_grow && lit;
             }
         }
     }

@@ -14,11 +14,15 @@ pub(crate) fn exposure(s: &Species, shadow: &ShadowGrid, node_end: Vec3) -> f32 
     (s.full_exposure - shadow.shadow_at(node_end) + s.shadow_strength).max(0.0)
 }
 
-/// Q = b·L^κ for enabled buds (0 for the others).
-pub(crate) fn bud_input(tree: &Tree, scratch: &mut Scratch) {
+/// Enables the buds that won at least one attraction point (step 2's end) and sets
+/// Q = b·L^κ for them (0 for the others); returns how many are enabled.
+pub(crate) fn bud_input(tree: &Tree, scratch: &mut Scratch) -> usize {
     let s = &tree.species;
     let nodes = &tree.skeleton.internodes;
+    let mut enabled = 0;
     for bud in &mut scratch.buds {
+        bud.enabled = bud.num_points > 0;
+        enabled += usize::from(bud.enabled);
         if !bud.enabled {
             bud.q = 0.0;
             continue;
@@ -34,6 +38,7 @@ pub(crate) fn bud_input(tree: &Tree, scratch: &mut Scratch) {
         };
         bud.q = b * bud.light.powf(s.light_sensitivity);
     }
+    enabled
 }
 
 /// b = cos²τ + d·sin²τ: τ the angle between the parent axis H and the vertical, d the distance

@@ -35,12 +35,8 @@ pub(crate) fn radii(tree: &Tree) -> (f32, f32, f32) {
 /// Runs step 2; returns the number of attraction points that survived occupancy.
 pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOptions) -> usize {
     let (r, perception, cos_half) = radii(tree);
-    // A bud in full shade (L = 0) can never grow when κ > 0 (Q = b·0^κ = 0): it neither generates
-    // nor takes points, which keeps dense crowns cheap without changing which buds grow.
-    let light_matters = tree.species.light_sensitivity > 0.0;
-    for bud in &mut scratch.buds {
-        bud.competes = bud.may_grow && (!light_matters || bud.light > 0.0);
-    }
+    // Only competing buds ([`super::buds::collect`] leaves out those in full shade when κ > 0,
+    // which can never grow) generate and take points.
     if options.autonomous {
         generate_points(tree, scratch, r, perception, cos_half);
     }
@@ -195,9 +191,6 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
         if let Some(t) = point.tropism {
             bud.tropism_sum += t;
         }
-    }
-    for bud in &mut scratch.buds {
-        bud.enabled = bud.num_points > 0;
     }
     alive_count
 }
