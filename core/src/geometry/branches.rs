@@ -336,12 +336,9 @@ impl RingFrames {
         }
         if let Some((tube, shrink)) = tube.zip(shrink) {
             // The first ring, written round its centre above, is laid onto the parent.
-            let out = RingOut {
-                positions: &mut mesh.positions[first_vertex..][..ring_size],
-                normals: &mut mesh.normals[first_vertex..][..ring_size],
-                uvs: &mut mesh.uvs[first_vertex..][..ring_size],
-            };
-            laid_ring(out, table, &rings[0], tube, shrink, du);
+            let positions = &mut mesh.positions[first_vertex..][..ring_size];
+            let normals = &mesh.normals[first_vertex..][..ring_size];
+            laid_ring(positions, normals, &rings[0], tube, shrink);
         }
         for ring_index in 0..rings.len() - 1 {
             let below = (first_vertex + ring_index * ring_size) as u32;
@@ -351,61 +348,40 @@ impl RingFrames {
     }
 }
 
-/// The vertex attributes of a laid first ring, to be written (the ambient is the ring's).
-struct RingOut<'a> {
-    positions: &'a mut [[f32; 3]],
-    normals: &'a mut [[f32; 3]],
-    uvs: &'a mut [[f32; 2]],
-}
-
-/// Writes a lateral chain's first ring laid onto its parent's surface, four vertices at a time
-/// (a ring has at least four vertices; the last group overlaps the one before when the count
-/// is not a multiple of four, and writes the shared vertices again with the same values). A
-/// group with a degenerate vertex is laid one vertex at a time.
+/// Lays a lateral chain's first ring, written round its centre, onto its parent's surface:
+/// moves the `positions` of its vertices, whose `normals` are their directions from the centre.
+/// Four vertices at a time (a ring has at least four vertices; the last group overlaps the one
+/// before when the count is not a multiple of four, and writes the shared vertices again with
+/// the same values); a group with a degenerate vertex is laid one vertex at a time.
 fn laid_ring(
-    out: RingOut,
-    table: &[(f32, f32)],
+    positions: &mut [[f32; 3]],
+    normals: &[[f32; 3]],
     ring: &Ring,
     tube: &ParentTube,
     shrink: f32,
-    du: f32,
 ) {
-    let (reference, binormal) = (ring.reference, ring.binormal);
-    let num_vertices = table.len();
-    let mut write = |k: usize, position: [f32; 3], direction: Vec3| {
-        out.positions[k] = position;
-        out.normals[k] = direction.to_array();
-        out.uvs[k] = [k as f32 * du + ring.u_offset, ring.v];
-    };
+    let num_vertices = positions.len();
     let mut start = 0;
     while start < num_vertices {
         let first = start.min(num_vertices.saturating_sub(4));
-        let Some(cs) = table.get(first..first + 4) else {
+        let Some(group) = normals.get(first..first + 4) else {
             // Fewer than four vertices in all.
-            for (k, &(cos, sin)) in table.iter().enumerate() {
-                let direction = reference * cos + binormal * sin;
-                write(
-                    k,
-                    onto_parent(tube, ring, direction, shrink).to_array(),
-                    direction,
-                );
+            for (position, &direction) in positions.iter_mut().zip(normals) {
+                *position = onto_parent(tube, ring, direction.into(), shrink).to_array();
             }
             return;
         };
-        let directions: [Vec3; 4] = std::array::from_fn(|i| {
-            let (cos, sin) = cs[i];
-            reference * cos + binormal * sin
-        });
+        let directions: [Vec3; 4] = std::array::from_fn(|i| Vec3::from(group[i]));
+        let laid = &mut positions[first..first + 4];
         match onto_parent4(tube, ring, V4::gather(directions), shrink) {
-            Some(positions) => {
-                for (i, &direction) in directions.iter().enumerate() {
-                    write(first + i, positions.lane(i), direction);
+            Some(projected) => {
+                for (i, position) in laid.iter_mut().enumerate() {
+                    *position = projected.lane(i);
                 }
             }
             None => {
-                for (i, &direction) in directions.iter().enumerate() {
-                    let position = onto_parent(tube, ring, direction, shrink);
-                    write(first + i, position.to_array(), direction);
+                for (position, direction) in laid.iter_mut().zip(directions) {
+                    *position = onto_parent(tube, ring, direction, shrink).to_array();
                 }
             }
         }

@@ -329,7 +329,6 @@ pub(crate) fn push_fruit(
     params: &FruitParams,
     ambient: AmbientFn,
 ) {
-    mesh.reserve(12 * centers.len(), 60 * centers.len());
     for &center in centers {
         push_icosahedron(mesh, center, params.radius, ambient(center).clamp(0.0, 1.0));
     }

@@ -104,12 +104,6 @@ impl Mesher {
         self.diameters.clear();
         self.fruit_centers.clear();
         self.links.clear();
-        // Room for every internode at once: a first build into fresh memory grows each array
-        // once instead of by doubling.
-        let num_nodes = skeleton.internodes.len();
-        self.nodes.reserve(num_nodes);
-        self.diameters.reserve(num_nodes);
-        self.links.reserve(num_nodes);
         for (index, node) in skeleton.internodes.iter().enumerate() {
             self.nodes.push(NodeGeom::new(node));
             self.diameters.push(node.diameter);

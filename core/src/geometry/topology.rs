@@ -135,14 +135,6 @@ impl Links {
         self.child_ranges.push(0);
     }
 
-    /// Makes room for the links of `num_nodes` more internodes (each has one parent, and all
-    /// but the root are someone's child).
-    pub(crate) fn reserve(&mut self, num_nodes: usize) {
-        self.parents.reserve(num_nodes);
-        self.children.reserve(num_nodes);
-        self.child_ranges.reserve(num_nodes);
-    }
-
     /// Appends the links of the next internode of the arena.
     pub(crate) fn push(&mut self, node: &Internode) {
         self.parents.push(node.parent.map_or(NONE, |p| p.0));
