@@ -44,6 +44,7 @@ const EPSILON_PX: f32 = 0.03;
 const MIN_EIGENVALUE: f32 = 0.1;
 
 /// One level: the image padded by [`PAD`] pixels of mirrored border.
+#[derive(Default)]
 struct Level {
     width: usize,
     height: usize,
@@ -68,23 +69,49 @@ pub struct LkOptions {
     pub max_fb_error_px: Option<f32>,
 }
 
+/// Memory reused from one pyramid build to the next (a frame's buffers are large enough that
+/// fresh ones cost page faults and zeroing every frame).
+#[derive(Default)]
+pub struct PyramidScratch {
+    base: Vec<f32>,
+    rows: Vec<f32>,
+    down: Vec<Vec<f32>>,
+    spare: Option<Vec<Level>>,
+}
+
 impl Pyramid {
     /// The pyramid of an 8-bit image: each level a 5-tap Gaussian (1 4 6 4 1)/16 then every
     /// other pixel, as OpenCV's `pyrDown`.
     pub fn build(image: &GrayImage) -> Self {
+        Self::build_with(image, &mut PyramidScratch::default())
+    }
+
+    /// [`Pyramid::build`] in memory from `scratch` (same result).
+    pub fn build_with(image: &GrayImage, scratch: &mut PyramidScratch) -> Self {
         let (width, height) = (image.width as usize, image.height as usize);
-        let base: Vec<f32> = image.pixels.iter().map(|&p| p as f32).collect();
-        let mut levels = Vec::with_capacity(LEVELS + 1);
-        let mut current = (base, width, height);
-        for level in 0..=LEVELS {
-            let (pixels, w, h) = &current;
-            levels.push(Level::new(pixels, *w, *h));
-            if level < LEVELS {
-                current = pyr_down(pixels, *w, *h);
-            }
+        scratch.base.clear();
+        scratch.base.extend(image.pixels.iter().map(|&p| p as f32));
+        scratch.down.resize_with(LEVELS, Vec::new);
+        let mut levels = scratch.spare.take().unwrap_or_default();
+        levels.resize_with(LEVELS + 1, Level::default);
+        let (mut w, mut h) = (width, height);
+        levels[0].fill(&scratch.base, w, h);
+        for (k, level) in levels.iter_mut().enumerate().skip(1) {
+            let (below, this) = scratch.down.split_at_mut(k - 1);
+            let src = below.last().unwrap_or(&scratch.base);
+            (w, h) = pyr_down(src, w, h, &mut scratch.rows, &mut this[0]);
+            level.fill(&this[0], w, h);
         }
         Self {
             levels: Arc::new(levels),
+        }
+    }
+
+    /// Hands the pyramid's memory to `scratch` for the next build, unless a clone (a
+    /// keyframe's) still shares it.
+    pub fn recycle(self, scratch: &mut PyramidScratch) {
+        if let Ok(levels) = Arc::try_unwrap(self.levels) {
+            scratch.spare = Some(levels);
         }
     }
 
@@ -108,11 +135,20 @@ fn reflect(i: isize, n: usize) -> usize {
     i as usize
 }
 
-fn pyr_down(src: &[f32], width: usize, height: usize) -> (Vec<f32>, usize, usize) {
+/// One level down from `src` (`width` × `height`) into `dst`, through `rows`; returns the new
+/// size.
+fn pyr_down(
+    src: &[f32],
+    width: usize,
+    height: usize,
+    rows: &mut Vec<f32>,
+    dst: &mut Vec<f32>,
+) -> (usize, usize) {
     const K: [f32; 5] = [1.0 / 16.0, 4.0 / 16.0, 6.0 / 16.0, 4.0 / 16.0, 1.0 / 16.0];
     let (w, h) = (width.div_ceil(2), height.div_ceil(2));
     // Horizontal filter and decimation: height × w.
-    let mut rows = vec![0.0f32; height * w];
+    rows.clear();
+    rows.resize(height * w, 0.0);
     for y in 0..height {
         let src_row = &src[y * width..(y + 1) * width];
         let out = &mut rows[y * w..(y + 1) * w];
@@ -129,7 +165,8 @@ fn pyr_down(src: &[f32], width: usize, height: usize) -> (Vec<f32>, usize, usize
         }
     }
     // Vertical filter and decimation.
-    let mut dst = vec![0.0f32; w * h];
+    dst.clear();
+    dst.resize(w * h, 0.0);
     for y in 0..h {
         let c = 2 * y as isize;
         let taps: [usize; 5] = std::array::from_fn(|k| reflect(c + k as isize - 2, height));
@@ -141,29 +178,25 @@ fn pyr_down(src: &[f32], width: usize, height: usize) -> (Vec<f32>, usize, usize
             }
         }
     }
-    (dst, w, h)
+    (w, h)
 }
 
 impl Level {
-    fn new(pixels: &[f32], width: usize, height: usize) -> Self {
+    /// This level made from `pixels` (`width` × `height`), reusing its memory.
+    fn fill(&mut self, pixels: &[f32], width: usize, height: usize) {
         let stride = width + 2 * PAD + SLACK;
         let rows = height + 2 * PAD;
-        let mut image = vec![0.0f32; stride * rows];
+        self.image.resize(stride * rows, 0.0);
         for y in 0..rows {
             let sy = reflect(y as isize - PAD as isize, height);
             let src = &pixels[sy * width..(sy + 1) * width];
-            let dst = &mut image[y * stride..(y + 1) * stride];
+            let dst = &mut self.image[y * stride..(y + 1) * stride];
             dst[PAD..PAD + width].copy_from_slice(src);
             for x in (0..PAD).chain(PAD + width..stride) {
                 dst[x] = src[reflect(x as isize - PAD as isize, width)];
             }
         }
-        Self {
-            width,
-            height,
-            stride,
-            image,
-        }
+        (self.width, self.height, self.stride) = (width, height, stride);
     }
 
     /// Top-left sample (in the padded plane) and bilinear weights of the `side`-pixel window
@@ -743,6 +776,31 @@ mod tests {
         // Unchecked, Lucas–Kanade settles somewhere in the pasted texture; checked, it is lost.
         assert!(unchecked[1].is_some_and(|p| (p - Vec2::new(128.0, 129.0)).length() > 1.0));
         assert_eq!(found[1], None);
+    }
+
+    #[test]
+    fn a_pyramid_built_in_recycled_memory_equals_a_fresh_one() {
+        let mut scratch = PyramidScratch::default();
+        // Memory first used for another size, then handed back.
+        Pyramid::build_with(&texture(200, 150, Vec2::ZERO), &mut scratch).recycle(&mut scratch);
+        let image = texture(320, 240, Vec2::new(0.5, 0.25));
+        let reused = Pyramid::build_with(&image, &mut scratch);
+        let fresh = Pyramid::build(&image);
+        for (a, b) in reused.levels.iter().zip(fresh.levels.iter()) {
+            assert_eq!((a.width, a.height, a.stride), (b.width, b.height, b.stride));
+            assert!(
+                a.image
+                    .iter()
+                    .zip(&b.image)
+                    .all(|(x, y)| x.to_bits() == y.to_bits())
+            );
+        }
+        // A pyramid a keyframe still shares is not taken back.
+        let shared = reused.clone();
+        reused.recycle(&mut scratch);
+        assert!(scratch.spare.is_none());
+        shared.recycle(&mut scratch);
+        assert!(scratch.spare.is_some());
     }
 
     #[test]

@@ -68,8 +68,8 @@ impl Tracker {
         }
         if self.keyframe_pyramids.len() > MAX_KEYFRAME_PYRAMIDS {
             let oldest = self.keyframe_pyramids.keys().copied().min();
-            if let Some(oldest) = oldest {
-                self.keyframe_pyramids.remove(&oldest);
+            if let Some(old) = oldest.and_then(|k| self.keyframe_pyramids.remove(&k)) {
+                old.recycle(&mut self.pyramid_scratch);
             }
         }
         if let Some(pose) = self.map.keyframes.get(kf).map(|k| k.camera_from_world) {

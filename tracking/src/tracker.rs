@@ -9,7 +9,7 @@ use crate::cv::{self, CvError, OrbFeatures};
 use crate::features::{Track, normalized};
 use crate::frame::{Frame, FrameOutput, Plane, TrackedPoint, TrackingState};
 use crate::initializer::Initializer;
-use crate::lk::{self, Pyramid};
+use crate::lk::{self, Pyramid, PyramidScratch};
 use crate::map::Map;
 use crate::pose::Se3;
 use crate::world::WorldFrame;
@@ -117,6 +117,8 @@ pub struct Tracker {
     pub(crate) map: Map,
     pub(crate) tracks: Vec<Track>,
     pub(crate) prev_pyramid: Option<Pyramid>,
+    /// Memory of pyramids no longer used, for the next frame's.
+    pub(crate) pyramid_scratch: PyramidScratch,
     /// `camera_from_world` (map frame) of the previous frame, and the motion since the one before.
     pub(crate) prev_pose: Option<Se3>,
     pub(crate) velocity: Se3,
@@ -145,6 +147,7 @@ impl Tracker {
             map: Map::default(),
             tracks: Vec::new(),
             prev_pyramid: None,
+            pyramid_scratch: PyramidScratch::default(),
             prev_pose: None,
             velocity: Se3::IDENTITY,
             velocity_dt_s: 0.0,
@@ -190,7 +193,7 @@ impl Tracker {
             self.gravity_up = Some(a.normalize());
         }
         let blank = frame.image.contrast() < 4.0;
-        let pyramid = Pyramid::build(&frame.image);
+        let pyramid = Pyramid::build_with(&frame.image, &mut self.pyramid_scratch);
         let pose = match self.state {
             TrackingState::NotInitialized | TrackingState::Initializing if blank => None,
             TrackingState::NotInitialized => {
@@ -218,7 +221,9 @@ impl Tracker {
                 }
                 self.last_pose_time_s = Some(frame.timestamp_s);
                 self.prev_pose = Some(pose);
-                self.prev_pyramid = Some(pyramid);
+                if let Some(old) = self.prev_pyramid.replace(pyramid) {
+                    old.recycle(&mut self.pyramid_scratch);
+                }
                 self.frames_since_keyframe += 1;
                 if self.needs_keyframe() {
                     self.insert_keyframe(frame, pose)?;
@@ -230,7 +235,9 @@ impl Tracker {
                 self.frames_failed += 1;
                 self.velocity = Se3::IDENTITY;
                 self.tracks.clear();
-                self.prev_pyramid = None;
+                if let Some(old) = self.prev_pyramid.take() {
+                    old.recycle(&mut self.pyramid_scratch);
+                }
                 self.state = if self.frames_failed > self.config.lost_after_frames {
                     TrackingState::Lost
                 } else {
