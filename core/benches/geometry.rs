@@ -9,9 +9,14 @@
 //!
 //! Each with fresh buffers and with a [`Mesher`] and output meshes reused from the previous
 //! call. Also the GLB encoding of the 10k tree.
+//!
+//! - `mesh_drawn_level_cpu`: the 100k drawn level reusing buffers again, measured in CPU time
+//!   of the benchmark thread (Linux `/proc/thread-self/schedstat`) instead of wall-clock time:
+//!   the one-core cost, without the time spent waiting for a core on a busy machine.
 
 use std::hint::black_box;
 
+use criterion::measurement::{Measurement, ValueFormatter, WallTime};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::Vec3;
 use sylva_core::export::glb_bytes;
@@ -81,5 +86,85 @@ fn meshing(c: &mut Criterion) {
     });
 }
 
+/// CPU time of the calling thread, in nanoseconds (wall-clock time where the kernel does not
+/// report it).
+struct ThreadCpuTime;
+
+impl ThreadCpuTime {
+    fn now_ns() -> u64 {
+        std::fs::read_to_string("/proc/thread-self/schedstat")
+            .ok()
+            .and_then(|text| text.split_whitespace().next()?.parse().ok())
+            .unwrap_or_else(|| {
+                static START: std::sync::OnceLock<std::time::Instant> = std::sync::OnceLock::new();
+                START
+                    .get_or_init(std::time::Instant::now)
+                    .elapsed()
+                    .as_nanos() as u64
+            })
+    }
+}
+
+impl Measurement for ThreadCpuTime {
+    type Intermediate = u64;
+    type Value = u64;
+
+    fn start(&self) -> u64 {
+        Self::now_ns()
+    }
+
+    fn end(&self, start: u64) -> u64 {
+        Self::now_ns().saturating_sub(start)
+    }
+
+    fn add(&self, a: &u64, b: &u64) -> u64 {
+        a + b
+    }
+
+    fn zero(&self) -> u64 {
+        0
+    }
+
+    fn to_f64(&self, value: &u64) -> f64 {
+        *value as f64
+    }
+
+    fn formatter(&self) -> &dyn ValueFormatter {
+        // Nanoseconds, as wall-clock time: shown as durations.
+        WallTime.formatter()
+    }
+}
+
+fn meshing_cpu(c: &mut Criterion<ThreadCpuTime>) {
+    let params = params();
+    let ambient = crown_ambient(Vec3::new(0.0, 1.5, 0.0), 2.0);
+    let skeleton = branching_skeleton(100_000, SEED);
+    let mut group = c.benchmark_group("mesh_drawn_level_cpu");
+    group.sample_size(20);
+    group.throughput(Throughput::Elements(100_000));
+    let mut mesher = Mesher::new();
+    let mut reused = TreeMeshes::default();
+    group.bench_function(
+        "100000_internodes_level0_with_leaves_reusing_buffers",
+        |b| {
+            b.iter(|| {
+                mesher.build_into(
+                    black_box(&skeleton),
+                    &params,
+                    &ambient,
+                    Levels::One(0),
+                    &mut reused,
+                )
+            })
+        },
+    );
+    group.finish();
+}
+
 criterion_group!(benches, meshing);
-criterion_main!(benches);
+criterion_group! {
+    name = cpu_benches;
+    config = Criterion::default().with_measurement(ThreadCpuTime);
+    targets = meshing_cpu
+}
+criterion_main!(benches, cpu_benches);
