@@ -263,8 +263,19 @@ pub fn homography_inliers(
         .unwrap_or(0))
 }
 
-/// Camera pose from 2D–3D correspondences by EPnP inside RANSAC: `camera_from_world` and the
-/// inlier indices. Image points are normalised undistorted coordinates.
+/// The minimal solver [`pnp_ransac`] runs on each hypothesis.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum PnpMinimal {
+    /// EPnP on five points.
+    Epnp,
+    /// Algebraic P3P on four points (three and one to choose among the solutions): several
+    /// times cheaper than EPnP's SVD, for the thousand hypotheses of relocalisation.
+    Ap3p,
+}
+
+/// Camera pose from 2D–3D correspondences inside RANSAC (the inliers refined by EPnP):
+/// `camera_from_world` and the inlier indices. Image points are normalised undistorted
+/// coordinates.
 pub fn pnp_ransac(
     camera: &Camera,
     world: &[DVec3],
@@ -272,6 +283,7 @@ pub fn pnp_ransac(
     guess: Option<Se3>,
     threshold_px: f32,
     iterations: i32,
+    minimal: PnpMinimal,
 ) -> Result<Option<(Se3, Vec<usize>)>> {
     if world.len() < 6 {
         return Ok(None);
@@ -301,7 +313,10 @@ pub fn pnp_ransac(
         threshold_px,
         0.99,
         &mut inliers,
-        calib3d::SOLVEPNP_EPNP,
+        match minimal {
+            PnpMinimal::Epnp => calib3d::SOLVEPNP_EPNP,
+            PnpMinimal::Ap3p => calib3d::SOLVEPNP_AP3P,
+        },
     )?;
     if !found || inliers.len() < 6 {
         return Ok(None);

@@ -371,6 +371,7 @@ impl Tracker {
                 Some(start),
                 self.config.outlier_px as f32,
                 100,
+                cv::PnpMinimal::Epnp,
             )? {
                 Some((found, _)) => pose = refine_pose(found, &world, &image, &self.ba_config(10)),
                 None => return Ok(None),
@@ -427,7 +428,13 @@ impl Tracker {
             .collect();
         // Descriptor matches of a blurred or changed view hold many wrong ones: sample enough
         // hypotheses to find the right pose among a third of inliers.
-        let found = cv::pnp_ransac(&self.camera, &world, &image, None, 4.0, 1000)?;
+        // Once lost, this runs on every frame until it succeeds: the four-point solver keeps
+        // each attempt cheap (and needs fewer hypotheses at a given inlier ratio).
+        let minimal = match self.state {
+            TrackingState::RecentlyLost | TrackingState::Lost => cv::PnpMinimal::Ap3p,
+            _ => cv::PnpMinimal::Epnp,
+        };
+        let found = cv::pnp_ransac(&self.camera, &world, &image, None, 4.0, 1000, minimal)?;
         let Some((pose, inliers)) = found else {
             return Ok(None);
         };
