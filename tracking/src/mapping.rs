@@ -209,28 +209,35 @@ impl Tracker {
     ) -> Result<(), TrackerError> {
         let tracked: HashSet<u64> = self.tracks.iter().filter_map(|t| t.point).collect();
         let center = pose.inverse().translation;
+        // Centres of the keyframes whose pyramids are kept (None for the others), by id.
+        let mut searchable: Vec<Option<DVec3>> = vec![None; self.map.keyframes.len()];
+        for &k in self.keyframe_pyramids.keys() {
+            if let Some(kf) = self.map.keyframes.get(k) {
+                searchable[k] = Some(kf.center());
+            }
+        }
         let mut wanted: Vec<(usize, u64, Vec2, Vec2)> = Vec::new();
+        // Cheapest tests first: most map points were last seen by keyframes without a pyramid.
         for point in self.map.points.values() {
             if tracked.contains(&point.id) {
+                continue;
+            }
+            let Some((obs, kf_center)) = point
+                .observations
+                .iter()
+                .filter_map(|o| Some((o, searchable.get(o.keyframe).copied().flatten()?)))
+                .max_by_key(|(o, _)| o.keyframe)
+            else {
+                continue;
+            };
+            // Skip views too different from the keyframe's (LK would not match them).
+            let angle = (point.position - kf_center).angle_between(point.position - center);
+            if angle.to_degrees() > 20.0 {
                 continue;
             }
             let Some(projected) = self.project(pose, point.position) else {
                 continue;
             };
-            let Some(obs) = point
-                .observations
-                .iter()
-                .filter(|o| self.keyframe_pyramids.contains_key(&o.keyframe))
-                .max_by_key(|o| o.keyframe)
-            else {
-                continue;
-            };
-            // Skip views too different from the keyframe's (LK would not match them).
-            let kf_center = self.map.keyframes[obs.keyframe].center();
-            let angle = (point.position - kf_center).angle_between(point.position - center);
-            if angle.to_degrees() > 20.0 {
-                continue;
-            }
             wanted.push((obs.keyframe, point.id, obs.pixel, projected));
         }
         wanted.sort_by_key(|w| std::cmp::Reverse(w.0));
