@@ -23,9 +23,10 @@ impl From<opencv::Error> for CvError {
 
 type Result<T> = std::result::Result<T, CvError>;
 
-/// Lucas–Kanade window (pixels) and pyramid levels.
-pub const LK_WINDOW: i32 = 21;
-pub const LK_LEVELS: i32 = 3;
+/// OpenCV's Lucas–Kanade runs with the window (pixels) and pyramid levels of the tracker's own
+/// ([`crate::lk`]), so the two are compared on the same solves.
+const LK_WINDOW: i32 = crate::lk::WINDOW as i32;
+const LK_LEVELS: i32 = crate::lk::LEVELS as i32;
 
 /// Runs OpenCV on one thread and quiets its logs. Every [`crate::Tracker`] does this: with
 /// OpenCV's worker threads the same footage gave different trajectories from run to run

@@ -29,9 +29,11 @@ const OUTER: usize = WINDOW + 2;
 /// next row then writes, or in the zero tail), read from this many more columns of each level.
 const ROW: usize = OUTER.div_ceil(LANES) * LANES;
 const SLACK: usize = ROW - WINDOW;
+/// Samples of a window.
 const AREA: usize = WINDOW * WINDOW;
-/// Samples of a window rounded up to whole lanes.
+/// Lanes of every sum (fixed, so results do not depend on the vector width).
 const LANES: usize = 8;
+/// A window's samples in whole lanes.
 const CHUNKS: usize = AREA.div_ceil(LANES);
 
 /// A window's samples, row-major, in whole lanes (the tail is zero).
