@@ -40,7 +40,7 @@ impl Tracker {
         }
         self.init = Some(Initializer {
             frame_index: frame.index,
-            pyramid: Pyramid::build(&frame.image),
+            pyramid: pyramid.clone(),
             current: corners.iter().copied().map(Some).collect(),
             reference: corners,
             history: Vec::new(),
