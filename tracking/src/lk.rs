@@ -607,6 +607,39 @@ pub fn track_points(
 ) -> Vec<Option<Vec2>> {
     let guess = guess.unwrap_or(from);
     let forward = lk(prev, next, from, guess, options.levels);
+    check_forward_backward(prev, next, from, forward, options)
+}
+
+/// [`track_points`] for points whose true position is known to lie within `max_from_guess_px`
+/// of their guess (a reprojection gate): a forward result farther than that is lost at once,
+/// without the backward pass it would pay for nothing (in the local-map search most forward
+/// results land outside the gate). Gives exactly what gating the result of [`track_points`]
+/// would.
+pub fn track_points_near_guess(
+    prev: &Pyramid,
+    next: &Pyramid,
+    from: &[Vec2],
+    guess: &[Vec2],
+    max_from_guess_px: f32,
+    options: LkOptions,
+) -> Vec<Option<Vec2>> {
+    let mut forward = lk(prev, next, from, guess, options.levels);
+    for (found, seed) in forward.iter_mut().zip(guess) {
+        if found.is_some_and(|f| f.distance(*seed) >= max_from_guess_px) {
+            *found = None;
+        }
+    }
+    check_forward_backward(prev, next, from, forward, options)
+}
+
+/// The forward-backward check of `options` on `forward` results, if it asks for one.
+fn check_forward_backward(
+    prev: &Pyramid,
+    next: &Pyramid,
+    from: &[Vec2],
+    forward: Vec<Option<Vec2>>,
+    options: LkOptions,
+) -> Vec<Option<Vec2>> {
     let Some(max_fb_error_px) = options.max_fb_error_px else {
         return forward;
     };
@@ -698,6 +731,35 @@ mod tests {
             max_fb_error_px: Some(1.0),
         };
         track_points(&prev, &next, &grid(), None, options)
+    }
+
+    #[test]
+    fn gating_at_the_guess_gives_exactly_the_gated_tracks() {
+        let shift = Vec2::new(2.2, 1.4);
+        let prev = Pyramid::build(&texture(320, 240, Vec2::ZERO));
+        let next = Pyramid::build(&texture(320, 240, shift));
+        let from = grid();
+        // Every other guess is the true position, the rest are 9 pixels off: LK from a far
+        // guess with one coarse level lands either on the point (far from its guess) or astray.
+        let guess: Vec<Vec2> = from
+            .iter()
+            .enumerate()
+            .map(|(i, p)| *p - shift + Vec2::new(if i % 2 == 0 { 0.0 } else { 9.0 }, 0.0))
+            .collect();
+        let options = LkOptions {
+            levels: 1,
+            max_fb_error_px: Some(1.0),
+        };
+        let gated = track_points_near_guess(&prev, &next, &from, &guess, 6.0, options);
+        let filtered: Vec<Option<Vec2>> = track_points(&prev, &next, &from, Some(&guess), options)
+            .into_iter()
+            .zip(&guess)
+            .map(|(found, seed)| found.filter(|f| f.distance(*seed) < 6.0))
+            .collect();
+        assert_eq!(gated, filtered);
+        let kept = gated.iter().filter(|g| g.is_some()).count();
+        assert!(kept >= from.len() / 2 - 1, "{kept} of {}", from.len());
+        assert!(kept < from.len(), "the far guesses are gated");
     }
 
     #[test]

@@ -28,6 +28,9 @@ fn median_depth(map: &crate::map::Map, keyframe: usize) -> f64 {
     )
 }
 
+/// A map point found by the local-map search must lie this close to its projection, pixels.
+const SEARCH_GATE_PX: f32 = 6.0;
+
 /// Keyframe pyramids kept for the local-map search.
 const MAX_KEYFRAME_PYRAMIDS: usize = 40;
 
@@ -253,11 +256,12 @@ impl Tracker {
             };
             let from: Vec<Vec2> = list.iter().map(|l| l.1).collect();
             let guess: Vec<Vec2> = list.iter().map(|l| l.2).collect();
-            let found = lk::track_points(
+            let found = lk::track_points_near_guess(
                 kf_pyramid,
                 pyramid,
                 &from,
-                Some(&guess),
+                &guess,
+                SEARCH_GATE_PX,
                 lk::LkOptions {
                     levels: self.config.search_lk_levels,
                     max_fb_error_px: self
@@ -266,8 +270,8 @@ impl Tracker {
                         .then_some(self.config.max_fb_error_px),
                 },
             );
-            for ((id, _, projected), pixel) in list.into_iter().zip(found) {
-                if let Some(pixel) = pixel.filter(|p| p.distance(projected) < 6.0) {
+            for ((id, _, _), pixel) in list.into_iter().zip(found) {
+                if let Some(pixel) = pixel {
                     self.tracks.push(Track {
                         pixel,
                         point: Some(id),
