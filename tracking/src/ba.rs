@@ -144,13 +144,23 @@ pub fn bundle_adjust(
             for k in 0..2 {
                 for a in 0..6 {
                     gc[6 * s + a] += jc[k][a] * res[k] * weight;
-                    for b in 0..6 {
+                    // Upper triangle of the camera's block only (see below).
+                    for b in a..6 {
                         u[(6 * s + a) * n + 6 * s + b] += jc[k][a] * jc[k][b] * weight;
                     }
                     wblock[a] += jp[k] * (jc[k][a] * weight);
                 }
             }
             w.push((s, o.point, wblock));
+        }
+        // U is block diagonal and each block symmetric: its lower triangles are the same
+        // products as the upper ones.
+        for s in 0..num_free {
+            for a in 0..6 {
+                for b in 0..a {
+                    u[(6 * s + a) * n + 6 * s + b] = u[(6 * s + b) * n + 6 * s + a];
+                }
+            }
         }
         let accepted = lm_step(
             poses,
@@ -298,13 +308,17 @@ pub fn refine_pose(pose: Se3, points: &[DVec3], normalized: &[DVec2], config: &B
             for k in 0..2 {
                 for a in 0..6 {
                     g[a] += jc[k][a] * res[k] * weight;
-                    for b in 0..6 {
+                    // Upper triangle only: the lower one holds the same products.
+                    for b in a..6 {
                         h[a * 6 + b] += jc[k][a] * jc[k][b] * weight;
                     }
                 }
             }
         }
         for a in 0..6 {
+            for b in 0..a {
+                h[a * 6 + b] = h[b * 6 + a];
+            }
             h[a * 6 + a] += 1e-6;
         }
         let minus_g: Vec<f64> = g.iter().map(|v| -v).collect();
