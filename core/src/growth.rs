@@ -118,6 +118,10 @@ pub(crate) struct Scratch {
     pub main_child: Vec<u32>,
     pub lateral_range: Vec<(u32, u32)>,
     pub lateral: Vec<u32>,
+    /// Every node born before this iteration had all its lateral buds dead at the start of
+    /// iteration `expired_at` ([`buds::collect`] kills them once they outlive the bud lifetime).
+    pub expired_below: u32,
+    pub expired_at: Option<u32>,
 }
 
 /// No node, in [`Scratch`]'s compact links.
