@@ -26,3 +26,57 @@ pub fn shared_data_dir() -> PathBuf {
 pub fn project_data_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../test-data")
 }
+
+pub mod blackout {
+    //! Forced losses of track: frames blanked in a TUM-layout sequence, and the comparison of
+    //! the world after recovery with an unbroken run's.
+
+    use std::ops::Range;
+    use std::path::Path;
+    use sylva_tracking::{
+        FrameOutput, FrameSource, GrayImage, SourceEvent, Tracker, TrackerConfig, TumSequence,
+    };
+
+    /// Tracks the sequence at `root` frame by frame up to frame `end` (exclusive), with the
+    /// frames in `blank` turned black.
+    pub fn track_blanking(root: &Path, blank: Range<usize>, end: usize) -> Vec<FrameOutput> {
+        let sequence =
+            TumSequence::open(root).unwrap_or_else(|e| panic!("{} is needed: {e}", root.display()));
+        let mut source = sequence.source();
+        let mut tracker = Tracker::new(sequence.camera, TrackerConfig::default()).expect("tracker");
+        let mut outputs = Vec::new();
+        while let Some(event) = source.next_event() {
+            let SourceEvent::Frame(mut frame) = event else {
+                panic!("{} has no bad frames", root.display());
+            };
+            if frame.index >= end {
+                break;
+            }
+            if blank.contains(&frame.index) {
+                frame.image = GrayImage::filled(frame.image.width, frame.image.height, 0);
+            }
+            let up = sequence.up_in_camera_at(frame.timestamp_s);
+            outputs.push(tracker.track(&frame, up.map(|u| u * 9.81)).expect("track"));
+        }
+        outputs
+    }
+
+    /// Camera-position distances, frame by frame from frame `from`, between two runs over the
+    /// same footage (frames with a pose in both), sorted.
+    pub fn world_offsets(lost: &[FrameOutput], clean: &[FrameOutput], from: usize) -> Vec<f64> {
+        let mut offsets: Vec<f64> = lost
+            .iter()
+            .zip(clean)
+            .skip(from)
+            .filter_map(|(l, c)| {
+                Some(
+                    l.world_from_camera?
+                        .translation
+                        .distance(c.world_from_camera?.translation),
+                )
+            })
+            .collect();
+        offsets.sort_by(f64::total_cmp);
+        offsets
+    }
+}

@@ -2,12 +2,9 @@
 //! 1.5 m above a flat lawn, ground normal +Y, truth in scene.json).
 
 use glam::DVec3;
-use sylva_tests::project_data_dir;
+use sylva_tests::{blackout, project_data_dir};
 use sylva_tracking::report::run_sequence;
-use sylva_tracking::{
-    FrameOutput, FrameSource, GrayImage, SourceEvent, Tracker, TrackerConfig, TrackingState,
-    TumSequence,
-};
+use sylva_tracking::{FrameOutput, TrackerConfig, TrackingState};
 
 const PATH_LENGTH_M: f64 = 4.26;
 
@@ -45,21 +42,7 @@ const RECOVERY_FRAMES: usize = 15;
 
 /// Tracks demo_garden frame by frame, blanking the frames in `blank`.
 fn track_blanking(blank: std::ops::Range<usize>) -> Vec<FrameOutput> {
-    let sequence = TumSequence::open(&project_data_dir().join("demo_garden")).expect("demo_garden");
-    let mut source = sequence.source();
-    let mut tracker = Tracker::new(sequence.camera, TrackerConfig::default()).expect("tracker");
-    let mut outputs = Vec::new();
-    while let Some(event) = source.next_event() {
-        let SourceEvent::Frame(mut frame) = event else {
-            panic!("demo_garden has no bad frames");
-        };
-        if blank.contains(&frame.index) {
-            frame.image = GrayImage::filled(frame.image.width, frame.image.height, 0);
-        }
-        let up = sequence.up_in_camera_at(frame.timestamp_s);
-        outputs.push(tracker.track(&frame, up.map(|u| u * 9.81)).expect("track"));
-    }
-    outputs
+    blackout::track_blanking(&project_data_dir().join("demo_garden"), blank, usize::MAX)
 }
 
 #[test]
@@ -86,19 +69,8 @@ fn after_a_forced_one_second_loss_tracking_recovers_into_the_same_world_within_2
     // The world after recovery is the world the tracker had before the loss (it relocalised in
     // its map rather than starting a new one): camera positions in it match, frame by frame,
     // those of the same tracker on the unbroken footage.
-    let mut offsets: Vec<f64> = lost[recovered..]
-        .iter()
-        .zip(&clean[recovered..])
-        .filter_map(|(l, c)| {
-            Some(
-                l.world_from_camera?
-                    .translation
-                    .distance(c.world_from_camera?.translation),
-            )
-        })
-        .collect();
+    let offsets = blackout::world_offsets(&lost, &clean, recovered);
     assert!(offsets.len() > 60, "{} frames compared", offsets.len());
-    offsets.sort_by(f64::total_cmp);
     let median = offsets[offsets.len() / 2];
     eprintln!("recovered at frame {recovered}; world offset median {median:.4} m");
     assert!(

@@ -35,6 +35,8 @@ mod initializer;
 #[cfg(feature = "opencv")]
 mod mapping;
 #[cfg(feature = "opencv")]
+mod relocalise;
+#[cfg(feature = "opencv")]
 pub mod report;
 #[cfg(feature = "opencv")]
 pub mod tracker;

@@ -1,7 +1,7 @@
 //! The monocular tracker (the ORB-SLAM split: frame → tracker → map): Lucas–Kanade tracks, two-
 //! view initialisation, per-frame pose from the map (motion-only refinement, PnP-RANSAC as a
 //! fallback), the local map searched in every frame, keyframes with local bundle adjustment, and
-//! relocalisation by ORB descriptors + PnP.
+//! relocalisation (module `relocalise`).
 
 use crate::ba::{BaConfig, refine_pose, reprojection_error_px};
 use crate::camera::Camera;
@@ -256,7 +256,7 @@ impl Tracker {
     ) -> Result<Option<Se3>, TrackerError> {
         let (Some(prev_pyramid), Some(prev_pose)) = (self.prev_pyramid.as_ref(), self.prev_pose)
         else {
-            return self.relocalise(frame);
+            return self.relocalise(frame, pyramid);
         };
         // Frames dropped since the last pose (a gap of at least one and a half frame intervals):
         // the constant-velocity prediction spans the whole gap.
@@ -295,7 +295,7 @@ impl Tracker {
         self.tracks = kept;
         let estimated = self.estimate_pose(predicted)?;
         let Some(pose) = estimated else {
-            return self.relocalise(frame);
+            return self.relocalise(frame, pyramid);
         };
         self.search_local_map(pyramid, &pose)?;
         Ok(self.estimate_pose(pose)?.or(Some(pose)))
@@ -396,63 +396,6 @@ impl Tracker {
             index += 1;
             keep
         });
-        Ok(Some(pose))
-    }
-
-    /// Relocalisation: ORB features of this frame matched to map-point descriptors, then PnP.
-    fn relocalise(&mut self, frame: &Frame) -> Result<Option<Se3>, TrackerError> {
-        let described: Vec<(u64, DVec3, crate::map::Descriptor)> = self
-            .map
-            .points
-            .values()
-            .filter_map(|p| Some((p.id, p.position, p.descriptor?)))
-            .collect();
-        if described.len() < 30 {
-            return Ok(None);
-        }
-        let features = self.orb.describe_corners(&frame.image, 1000, 7.0)?;
-        let mut matches: Vec<(u64, DVec3, Vec2)> = Vec::new();
-        for (pixel, descriptor) in &features {
-            let mut nearest = cv::NearestTwo::default();
-            for (k, (_, _, d)) in described.iter().enumerate() {
-                nearest.offer(cv::hamming(descriptor, d), k);
-            }
-            if let Some((k, _)) = nearest.accepted(50, 0.8) {
-                matches.push((described[k].0, described[k].1, *pixel));
-            }
-        }
-        let world: Vec<DVec3> = matches.iter().map(|m| m.1).collect();
-        let image: Vec<DVec2> = matches
-            .iter()
-            .map(|m| normalized(&self.camera, m.2))
-            .collect();
-        // Descriptor matches of a blurred or changed view hold many wrong ones: sample enough
-        // hypotheses to find the right pose among a third of inliers.
-        // Once lost, this runs on every frame until it succeeds: the four-point solver keeps
-        // each attempt cheap (and needs fewer hypotheses at a given inlier ratio).
-        let minimal = match self.state {
-            TrackingState::RecentlyLost | TrackingState::Lost => cv::PnpMinimal::Ap3p,
-            _ => cv::PnpMinimal::Epnp,
-        };
-        let found = cv::pnp_ransac(&self.camera, &world, &image, None, 4.0, 1000, minimal)?;
-        let Some((pose, inliers)) = found else {
-            return Ok(None);
-        };
-        if inliers.len() < 25 {
-            return Ok(None);
-        }
-        let (w, n): (Vec<DVec3>, Vec<DVec2>) =
-            inliers.iter().map(|&k| (world[k], image[k])).unzip();
-        let pose = refine_pose(pose, &w, &n, &self.ba_config(10));
-        self.tracks = inliers
-            .iter()
-            .map(|&k| Track {
-                pixel: matches[k].2,
-                point: Some(matches[k].0),
-                origin: None,
-            })
-            .collect();
-        self.prev_pose = None;
         Ok(Some(pose))
     }
 
