@@ -400,7 +400,7 @@ impl Candidates {
             if nearest > r2 || nearest == f32::INFINITY {
                 return None;
             }
-            let j = self.d2.iter().position(|&d| d == nearest)?;
+            let j = first_equal(&self.d2, nearest)?;
             let p = Vec3::new(self.x[j], self.y[j], self.z[j]);
             if let Some(found) = accept(self.index[j], p, nearest) {
                 return Some((found, nearest));
@@ -409,6 +409,25 @@ impl Candidates {
             self.d2[j] = f32::INFINITY;
         }
     }
+}
+
+/// The first index holding `value`, eight values at a time (one packed compare and one branch
+/// per eight, instead of a branch per value).
+fn first_equal(values: &[f32], value: f32) -> Option<usize> {
+    const LANES: usize = 8;
+    let chunks = values.chunks_exact(LANES);
+    let rest = chunks.remainder();
+    for (c, chunk) in chunks.enumerate() {
+        let mut bits = 0u32;
+        for (k, &d) in chunk.iter().enumerate() {
+            bits |= u32::from(d == value) << k;
+        }
+        if bits != 0 {
+            return Some(c * LANES + bits.trailing_zeros() as usize);
+        }
+    }
+    let tail = values.len() - rest.len();
+    rest.iter().position(|&d| d == value).map(|k| tail + k)
 }
 
 /// The smallest value (∞ for none; NaNs ignored), in eight independent lanes so that it

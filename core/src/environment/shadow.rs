@@ -8,6 +8,11 @@
 //! Values are fixed-point integers, so adding and removing nodes in any order gives exactly the
 //! same grid: incremental updates during growth, a rebuild after loading and an "ungrow" all agree
 //! bit for bit. Voxels live in 8³ bricks allocated where shade falls (see [`ShadowGrid`]).
+//!
+//! Within a brick layer every column along z is stored as differences: a voxel's value is the
+//! sum of its column's entries from the brick's first row up to its own. A pyramid level then
+//! adds Δs on the first row of its square in the brick and takes it off the row after the last
+//! (two row updates, whatever the square's depth), and a lookup sums at most eight entries.
 
 use glam::{IVec3, Vec3};
 
@@ -46,8 +51,9 @@ const COLUMN_MASKS: [[[i32; ROW]; ROW]; ROW] = {
     }
     masks
 };
-/// One horizontal layer of a brick, 8 rows (z) of 8 values (x), aligned to cache lines so that
-/// a row never straddles two.
+/// One horizontal layer of a brick, 8 rows (z) of 8 entries (x), aligned to cache lines so that
+/// a row never straddles two. Entry (z, x) is the shadow of voxel (z, x) minus that of (z − 1, x)
+/// (row 0 holds its own values).
 #[derive(Clone, Copy, Debug)]
 #[repr(C, align(64))]
 struct Layer([[i32; ROW]; ROW]);
@@ -129,14 +135,21 @@ impl ShadowGrid {
         }
         let local = (v & (BRICK - 1)).as_uvec3();
         let layer = self.brick_layer(brick as usize, local.y as usize);
-        layer[local.z as usize][local.x as usize] as f32 / UNITS_PER_SHADOW
+        // The column's differences up to this row (a fixed loop of eight masked adds).
+        let (x, z) = (local.x as usize, local.z);
+        let mut value = 0i32;
+        for (row, r) in layer.iter().zip(0u32..) {
+            value = value.wrapping_add(if r <= z { row[x] } else { 0 });
+        }
+        value as f32 / UNITS_PER_SHADOW
     }
 
     /// Adds (`sign` = 1) or removes (`sign` = −1) the shadow pyramid of a node.
     ///
     /// Brick by brick: each brick the pyramid reaches is looked up once, then the levels q that
-    /// lie in it add their square's rows there, each row one fixed 8-wide add of Δs masked to
-    /// the square's columns (two SIMD adds, no scalar loop).
+    /// lie in it add Δs, masked to their square's columns, on the row where the square starts in
+    /// the brick and take it off the row after the one where it ends (if that row is in the
+    /// brick): two fixed 8-wide updates per level and brick, no loop over the square's rows.
     pub fn apply_node(&mut self, node_in_world: Vec3, sign: i32) {
         if self.level_units.is_empty() || !node_in_world.is_finite() {
             return;
@@ -159,24 +172,26 @@ impl ShadowGrid {
                         continue;
                     }
                     let brick = self.brick_at(IVec3::new(bx, by, bz));
+                    let (units, layers) = self.brick_layers_mut(brick);
                     for q in q_first..=q_hi {
-                        let delta = sign * self.level_units[q as usize];
-                        let layer =
-                            self.brick_layer_mut(brick, ((top.y - q) & (BRICK - 1)) as usize);
+                        let delta = sign * units[q as usize];
+                        let layer = &mut layers[((top.y - q) & (BRICK - 1)) as usize].0;
                         let x0 = ((top.x - q).max(bx << BRICK_SHIFT) & (BRICK - 1)) as usize;
                         let x1 = ((top.x + q).min((bx << BRICK_SHIFT) + BRICK - 1) & (BRICK - 1))
                             as usize;
                         let z0 = ((top.z - q).max(bz << BRICK_SHIFT) & (BRICK - 1)) as usize;
                         let z1 = ((top.z + q).min((bz << BRICK_SHIFT) + BRICK - 1) & (BRICK - 1))
                             as usize;
-                        let mut lanes = [0i32; ROW];
-                        for (lane, &m) in lanes.iter_mut().zip(&COLUMN_MASKS[x0][x1]) {
-                            *lane = delta & m;
+                        // A square that runs to the brick's last row has no row after it here:
+                        // the update then lands on row 0 with nothing to take off (no branch).
+                        let end_delta = if z1 + 1 < ROW { delta } else { 0 };
+                        let end_row = (z1 + 1) & (ROW - 1);
+                        let columns = &COLUMN_MASKS[x0][x1];
+                        for (value, &m) in layer[z0].iter_mut().zip(columns) {
+                            *value = value.wrapping_add(delta & m);
                         }
-                        for row in &mut layer[z0..=z1] {
-                            for (value, lane) in row.iter_mut().zip(lanes) {
-                                *value += lane;
-                            }
+                        for (value, &m) in layer[end_row].iter_mut().zip(columns) {
+                            *value = value.wrapping_sub(end_delta & m);
                         }
                     }
                 }
@@ -203,10 +218,12 @@ impl ShadowGrid {
         }
     }
 
-    /// Layer `local_y` of brick `brick`: 8 rows (z) of 8 values (x).
-    fn brick_layer_mut(&mut self, brick: usize, local_y: usize) -> &mut [[i32; ROW]; ROW] {
-        let layer = (brick % BRICKS_PER_CHUNK) * ROW + (local_y & (ROW - 1));
-        &mut self.chunks[brick / BRICKS_PER_CHUNK][layer].0
+    /// The layers (y = 0..8) of brick `brick`, with Δs of every level.
+    fn brick_layers_mut(&mut self, brick: usize) -> (&[i32], &mut [Layer; ROW]) {
+        let first = (brick % BRICKS_PER_CHUNK) * ROW;
+        let chunk = &mut self.chunks[brick / BRICKS_PER_CHUNK][first..first + ROW];
+        let layers = <&mut [Layer; ROW]>::try_from(chunk).unwrap_or_else(|_| unreachable!());
+        (&self.level_units, layers)
     }
 
     /// The brick at brick coordinates `b` (inside the index box), allocated if missing.
