@@ -269,25 +269,23 @@ impl Tree {
     }
 
     /// [`Tree::remove_subtrees`] given the flags of every internode to remove (closed under
-    /// descendants, one per internode).
+    /// descendants, one per internode). The compaction of the arena hands over the removed
+    /// internodes, whose shadow is then taken away (integer sums: the order does not matter).
     fn remove_flagged_subtrees(&mut self, flags: &[bool]) -> usize {
-        let gone_ends = self
-            .skeleton
-            .internodes
-            .iter()
-            .zip(flags)
-            .filter(|&(_, &gone)| gone)
-            .map(|(node, _)| node.end);
-        let count = gone_ends.clone().count();
-        self.environment.shadow.apply_nodes(gone_ends, -1);
-        if count == 0 {
+        if !flags.iter().any(|&gone| gone) {
             return 0;
         }
-        let remap = self.skeleton.remove_flagged(flags);
+        let mut gone_ends = Vec::new();
+        let remap = self
+            .skeleton
+            .remove_closed_flags(flags, |node| gone_ends.push(node.end));
+        self.environment
+            .shadow
+            .apply_nodes(gone_ends.iter().copied(), -1);
         self.growth_mask = self
             .growth_mask
             .and_then(|m| remap.get(m.index()).copied().flatten());
-        count
+        gone_ends.len()
     }
 
     /// Cuts every internode that entered occupied space, with its subtree. Returns the count.

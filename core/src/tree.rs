@@ -207,6 +207,45 @@ impl Skeleton {
         remap
     }
 
+    /// [`Skeleton::remove_flagged`] for flags closed under descendants (a removed internode's
+    /// children are flagged too, as [`Skeleton::subtree_flags`] makes them), one flag per
+    /// internode: the new ids follow from the flags alone, so the arena is read once, by the
+    /// compaction, which hands every removed internode to `on_removed` (in arena order) before
+    /// dropping it.
+    pub(crate) fn remove_closed_flags(
+        &mut self,
+        removed: &[bool],
+        mut on_removed: impl FnMut(&Internode),
+    ) -> Vec<Option<NodeId>> {
+        let mut next = 0u32;
+        let remap: Vec<Option<NodeId>> = (0..self.internodes.len())
+            .map(|i| {
+                if removed.get(i).copied().unwrap_or(true) {
+                    None
+                } else {
+                    next += 1;
+                    Some(NodeId(next - 1))
+                }
+            })
+            .collect();
+        let mut read = 0;
+        self.internodes.retain_mut(|node| {
+            read += 1;
+            if remap[read - 1].is_none() {
+                on_removed(node);
+                return false;
+            }
+            node.parent = node.parent.and_then(|p| remap[p.index()]);
+            node.main_child = node.main_child.and_then(|c| remap[c.index()]);
+            node.lateral_children.retain(|c| remap[c.index()].is_some());
+            for c in &mut node.lateral_children {
+                *c = remap[c.index()].unwrap_or(*c);
+            }
+            true
+        });
+        remap
+    }
+
     /// Checks the arena invariants listed in the module doc.
     pub fn sanity_check(&self) -> Result<(), TreeInvariantError> {
         let broken = |index: usize, what: String| Err(TreeInvariantError::Broken { index, what });
@@ -251,3 +290,40 @@ impl Skeleton {
 
 /// Shared by every module that needs per-tree randomness.
 pub type TreeRng = Rng;
+
+#[cfg(test)]
+mod tests {
+    use crate::Tree;
+    use crate::species::Species;
+
+    use super::NodeId;
+
+    #[test]
+    fn compacting_by_closed_flags_matches_remove_flagged_and_hands_over_every_removed_node() {
+        let mut tree = Tree::new(Species::by_name("oak").expect("oak preset"), 5);
+        tree.grow(6, None);
+        let nodes = tree.skeleton.len();
+        let roots: Vec<NodeId> = (1..nodes as u32).step_by(37).map(NodeId).collect();
+        let flags = tree.skeleton.subtree_flags(&roots);
+        let flagged: Vec<_> = (0..nodes).filter(|&i| flags[i]).collect();
+        assert!(
+            flagged.len() > 10 && flagged.len() < nodes,
+            "{}",
+            flagged.len()
+        );
+        let before = tree.skeleton.clone();
+        let mut expected = before.clone();
+        let expected_remap = expected.remove_flagged(&flags);
+        let mut handed = Vec::new();
+        let remap = tree
+            .skeleton
+            .remove_closed_flags(&flags, |node| handed.push(node.end));
+        assert_eq!(remap, expected_remap);
+        assert_eq!(tree.skeleton, expected);
+        let ends: Vec<_> = flagged.iter().map(|&i| before.internodes[i].end).collect();
+        assert_eq!(handed, ends);
+        tree.skeleton
+            .sanity_check()
+            .expect("compacted arena is sound");
+    }
+}
