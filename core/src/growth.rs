@@ -91,6 +91,9 @@ pub(crate) struct Scratch {
     /// Buds of node i are `buds[node_bud_start[i]..node_bud_start[i + 1]]`, terminal first.
     pub node_bud_start: Vec<u32>,
     pub positions: Vec<Vec3>,
+    /// The end of every internode, in arena order, taken by [`buds::collect`] (the arena does
+    /// not change until the shoots grow).
+    pub node_end: Vec<Vec3>,
     pub bud_grid: crate::environment::SpatialGrid,
     pub node_grid: crate::environment::SpatialGrid,
     pub point_grid: crate::environment::SpatialGrid,

@@ -22,7 +22,8 @@ pub struct SpatialGrid {
     entry_index: Vec<u32>,
     /// Position of each entry, sorted by cell (kept next to the index for cache-friendly scans).
     entry_position: Vec<Vec3>,
-    /// The same positions by coordinate, for gathering whole rows at once.
+    /// The same positions by coordinate, for gathering whole rows at once (empty unless the
+    /// grid was built by [`SpatialGrid::rebuild_for_gathers`]).
     entry_x: Vec<f32>,
     entry_y: Vec<f32>,
     entry_z: Vec<f32>,
@@ -32,6 +33,16 @@ pub struct SpatialGrid {
 impl SpatialGrid {
     /// Rebuilds the grid over `positions` with cells of at least `cell_size` metres.
     pub fn rebuild(&mut self, positions: &[Vec3], cell_size: f32) {
+        self.rebuild_with(positions, cell_size, false);
+    }
+
+    /// [`SpatialGrid::rebuild`] for a grid queried mostly by [`SpatialGrid::gather_box`]: it
+    /// also keeps the positions by coordinate, so that gathers copy whole rows of each.
+    pub fn rebuild_for_gathers(&mut self, positions: &[Vec3], cell_size: f32) {
+        self.rebuild_with(positions, cell_size, true);
+    }
+
+    fn rebuild_with(&mut self, positions: &[Vec3], cell_size: f32, by_coordinate: bool) {
         self.entry_index.clear();
         self.entry_position.clear();
         self.entry_x.clear();
@@ -72,9 +83,6 @@ impl SpatialGrid {
         }
         self.entry_index.resize(positions.len(), 0);
         self.entry_position.resize(positions.len(), Vec3::ZERO);
-        self.entry_x.resize(positions.len(), 0.0);
-        self.entry_y.resize(positions.len(), 0.0);
-        self.entry_z.resize(positions.len(), 0.0);
         // Fill each cell in input order (stable): the cursor is cell_start shifted by one.
         for (i, p) in positions.iter().enumerate() {
             let c = self.cell_of[i] as usize;
@@ -82,9 +90,11 @@ impl SpatialGrid {
             self.cell_start[c] += 1;
             self.entry_index[slot] = i as u32;
             self.entry_position[slot] = *p;
-            self.entry_x[slot] = p.x;
-            self.entry_y[slot] = p.y;
-            self.entry_z[slot] = p.z;
+        }
+        if by_coordinate {
+            self.entry_x.extend(self.entry_position.iter().map(|p| p.x));
+            self.entry_y.extend(self.entry_position.iter().map(|p| p.y));
+            self.entry_z.extend(self.entry_position.iter().map(|p| p.z));
         }
         for c in (1..=num_cells).rev() {
             self.cell_start[c] = self.cell_start[c - 1];
@@ -99,6 +109,7 @@ impl SpatialGrid {
     /// Keeps only the entries whose original index `keep` accepts, in place: the cells, and the
     /// order of the kept entries within them, stay as they were.
     pub fn retain(&mut self, keep: impl Fn(u32) -> bool) {
+        let by_coordinate = self.has_coordinates();
         let mut write = 0;
         let mut start = 0;
         for c in 0..self.cell_start.len().saturating_sub(1) {
@@ -108,9 +119,11 @@ impl SpatialGrid {
                 if keep(self.entry_index[read]) {
                     self.entry_index[write] = self.entry_index[read];
                     self.entry_position[write] = self.entry_position[read];
-                    self.entry_x[write] = self.entry_x[read];
-                    self.entry_y[write] = self.entry_y[read];
-                    self.entry_z[write] = self.entry_z[read];
+                    if by_coordinate {
+                        self.entry_x[write] = self.entry_x[read];
+                        self.entry_y[write] = self.entry_y[read];
+                        self.entry_z[write] = self.entry_z[read];
+                    }
                     write += 1;
                 }
             }
@@ -128,6 +141,11 @@ impl SpatialGrid {
 
     pub fn is_empty(&self) -> bool {
         self.entry_index.is_empty()
+    }
+
+    /// Whether the positions are also kept by coordinate ([`SpatialGrid::rebuild_for_gathers`]).
+    fn has_coordinates(&self) -> bool {
+        self.entry_x.len() == self.entry_index.len()
     }
 
     /// Every stored point as (index, position), cell by cell: neighbours in space come close
@@ -165,12 +183,20 @@ impl SpatialGrid {
         let Some((lo, hi)) = self.cell_range(lo, hi) else {
             return;
         };
+        let by_coordinate = self.has_coordinates();
         for z in lo.z..=hi.z {
             for y in lo.y..=hi.y {
                 let slots = self.row_slots(y, z, lo.x, hi.x);
-                out.x.extend_from_slice(&self.entry_x[slots.clone()]);
-                out.y.extend_from_slice(&self.entry_y[slots.clone()]);
-                out.z.extend_from_slice(&self.entry_z[slots.clone()]);
+                if by_coordinate {
+                    out.x.extend_from_slice(&self.entry_x[slots.clone()]);
+                    out.y.extend_from_slice(&self.entry_y[slots.clone()]);
+                    out.z.extend_from_slice(&self.entry_z[slots.clone()]);
+                } else {
+                    let row = &self.entry_position[slots.clone()];
+                    out.x.extend(row.iter().map(|p| p.x));
+                    out.y.extend(row.iter().map(|p| p.y));
+                    out.z.extend(row.iter().map(|p| p.z));
+                }
                 out.index.extend_from_slice(&self.entry_index[slots]);
             }
         }
@@ -501,6 +527,9 @@ mod tests {
         }
         let mut grid = SpatialGrid::default();
         grid.rebuild(&points, 0.2);
+        // Gathers from a grid that keeps positions by coordinate and from one that does not.
+        let mut by_coordinate = SpatialGrid::default();
+        by_coordinate.rebuild_for_gathers(&points, 0.2);
         let mut candidates = Candidates::default();
         for q in 0..200 {
             let radius = rng.range_f32(0.05, 0.5);
@@ -511,7 +540,7 @@ mod tests {
                 rng.in_unit_ball() * 2.0
             };
             let hi = lo + Vec3::splat(rng.range_f32(0.0, 0.4));
-            grid.gather_box(
+            [&grid, &by_coordinate][q % 2].gather_box(
                 lo - Vec3::splat(radius),
                 hi + Vec3::splat(radius),
                 &mut candidates,
@@ -538,6 +567,9 @@ mod tests {
         }
         let mut grid = SpatialGrid::default();
         grid.rebuild(&points, 0.3);
+        // Gathers from a grid that keeps positions by coordinate and from one that does not.
+        let mut by_coordinate = SpatialGrid::default();
+        by_coordinate.rebuild_for_gathers(&points, 0.3);
         let mut candidates = Candidates::default();
         let (mut inside, mut outside) = (0, 0);
         for q in 0..300 {
@@ -553,7 +585,7 @@ mod tests {
             };
             let hi = lo + Vec3::splat(rng.range_f32(0.0, 0.3));
             let reach = Vec3::splat(radius);
-            grid.gather_box(lo - reach, hi + reach, &mut candidates);
+            [&grid, &by_coordinate][q % 2].gather_box(lo - reach, hi + reach, &mut candidates);
             for k in 0..4 {
                 let t = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32());
                 let center = if k == 0 { lo } else { lo + (hi - lo) * t };

@@ -70,6 +70,7 @@ pub(crate) fn collect(tree: &mut Tree, scratch: &mut Scratch) {
     let nodes = &mut tree.skeleton.internodes;
     scratch.buds.clear();
     scratch.node_bud_start.clear();
+    scratch.node_end.clear();
     scratch.in_mask.clear();
     scratch
         .in_mask
@@ -98,6 +99,7 @@ pub(crate) fn collect(tree: &mut Tree, scratch: &mut Scratch) {
         }
         let first = scratch.buds.len();
         scratch.node_bud_start.push(first as u32);
+        scratch.node_end.push(node.end);
         let may_grow = scratch.in_mask[i];
         let mut push = |slot: u32, direction: Vec3| {
             scratch.buds.push(BudState {

@@ -66,14 +66,10 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
     };
     // Occupancy: every node (internode end) holds buds or did; its sphere takes points away.
     scratch.positions.clear();
-    scratch.positions.extend(
-        tree.skeleton
-            .internodes
-            .iter()
-            .map(|n| n.end)
-            .filter(|&e| near(e, r)),
-    );
-    scratch.node_grid.rebuild(&scratch.positions, r);
+    scratch
+        .positions
+        .extend(scratch.node_end.iter().copied().filter(|&e| near(e, r)));
+    scratch.node_grid.rebuild_for_gathers(&scratch.positions, r);
     // The point grid serves the shoots later (perception, consumption); built now, its cell
     // order also orders the queries below so that neighbouring queries share cached cells.
     scratch.positions.clear();
@@ -127,7 +123,7 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
         .push(scratch.competing_buds.len() as u32);
     scratch
         .bud_grid
-        .rebuild(&scratch.positions, PERCEPTION_CELL_FRACTION * perception);
+        .rebuild_for_gathers(&scratch.positions, PERCEPTION_CELL_FRACTION * perception);
     // Each surviving point's winner (bud, distance²), found in the point grid's cell order, then
     // summed in point order (the order of the sums fixes their rounding).
     let (starts, competing) = (&scratch.competing_start, &scratch.competing_buds);
