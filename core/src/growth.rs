@@ -102,11 +102,15 @@ pub(crate) struct Scratch {
     pub candidates: crate::environment::Candidates,
     /// The bud each attraction point feeds and its distance² (colonization).
     pub point_winner: Vec<(u32, f32)>,
-    /// The competing buds of entry i of `bud_grid` (a node) are
+    /// The competing buds of entry i of `bud_grid` (a node; entries are numbered by slot, see
+    /// [`crate::environment::SpatialGrid::number_entries_by_slot`]) are
     /// `competing_buds[competing_start[i]..competing_start[i + 1]]`, as (index in `buds`,
     /// direction), in bud order: compact, for the hot perception loop.
     pub competing_start: Vec<u32>,
     pub competing_buds: Vec<(u32, Vec3)>,
+    /// The same in `bud_grid`'s slot order, built from them (then swapped in).
+    pub sorted_start: Vec<u32>,
+    pub sorted_buds: Vec<(u32, Vec3)>,
     pub q_main: Vec<f32>,
     pub q_lateral: Vec<f32>,
     pub vigor: Vec<f32>,

@@ -143,6 +143,21 @@ impl SpatialGrid {
         self.entry_index.is_empty()
     }
 
+    /// The original index of every entry, slot by slot (cell by cell, input order within a
+    /// cell).
+    pub fn entry_indices(&self) -> &[u32] {
+        &self.entry_index
+    }
+
+    /// Renumbers the entries by slot: entry s, the s-th in [`SpatialGrid::entry_indices`]
+    /// order, is reported as index s from now on (for a caller that reordered its own data the
+    /// same way). Positions, cells and scan order stay as they were.
+    pub fn number_entries_by_slot(&mut self) {
+        for (slot, index) in self.entry_index.iter_mut().enumerate() {
+            *index = slot as u32;
+        }
+    }
+
     /// Whether the positions are also kept by coordinate ([`SpatialGrid::rebuild_for_gathers`]).
     fn has_coordinates(&self) -> bool {
         self.entry_x.len() == self.entry_index.len()
@@ -635,6 +650,28 @@ mod tests {
         assert!(grid.entries().all(|(i, p)| points[i as usize] == p));
         seen.sort_unstable();
         assert_eq!(seen, (0..500).collect::<Vec<u32>>());
+    }
+
+    #[test]
+    fn entries_renumbered_by_slot_keep_their_positions_and_scan_order() {
+        let mut rng = Rng::new(29);
+        let points: Vec<Vec3> = (0..400).map(|_| rng.in_unit_ball() * 2.0).collect();
+        let mut grid = SpatialGrid::default();
+        grid.rebuild_for_gathers(&points, 0.5);
+        let order = grid.entry_indices().to_vec();
+        let mut renumbered = grid.clone();
+        renumbered.number_entries_by_slot();
+        let reordered: Vec<Vec3> = order.iter().map(|&i| points[i as usize]).collect();
+        let mut candidates = Candidates::default();
+        let (lo, hi) = (Vec3::splat(-0.7), Vec3::splat(0.4));
+        renumbered.gather_box(lo, hi, &mut candidates);
+        let by_slot: Vec<u32> = candidates.index.clone();
+        grid.gather_box(lo, hi, &mut candidates);
+        assert!(by_slot.len() > 20);
+        for (slot, original) in by_slot.iter().zip(&candidates.index) {
+            assert_eq!(order[*slot as usize], *original);
+            assert_eq!(reordered[*slot as usize], points[*original as usize]);
+        }
     }
 
     #[test]

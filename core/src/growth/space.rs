@@ -124,6 +124,22 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
     scratch
         .bud_grid
         .rebuild_for_gathers(&scratch.positions, PERCEPTION_CELL_FRACTION * perception);
+    // The buds in the grid's cell order, the grid's entries renumbered to match: candidates
+    // gathered from neighbouring cells then find their buds next to each other in memory.
+    scratch.sorted_start.clear();
+    scratch.sorted_buds.clear();
+    for &i in scratch.bud_grid.entry_indices() {
+        let i = i as usize;
+        let range = scratch.competing_start[i] as usize..scratch.competing_start[i + 1] as usize;
+        scratch.sorted_start.push(scratch.sorted_buds.len() as u32);
+        scratch
+            .sorted_buds
+            .extend_from_slice(&scratch.competing_buds[range]);
+    }
+    scratch.sorted_start.push(scratch.sorted_buds.len() as u32);
+    std::mem::swap(&mut scratch.sorted_start, &mut scratch.competing_start);
+    std::mem::swap(&mut scratch.sorted_buds, &mut scratch.competing_buds);
+    scratch.bud_grid.number_entries_by_slot();
     // Each surviving point's winner (bud, distance²), found in the point grid's cell order, then
     // summed in point order (the order of the sums fixes their rounding).
     let (starts, competing) = (&scratch.competing_start, &scratch.competing_buds);
