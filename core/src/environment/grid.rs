@@ -202,6 +202,16 @@ impl SpatialGrid {
         for z in lo.z..=hi.z {
             for y in lo.y..=hi.y {
                 let slots = self.row_slots(y, z, lo.x, hi.x);
+                let n = slots.len();
+                if by_coordinate && n <= SHORT_ROW && slots.start + SHORT_ROW <= self.len() {
+                    // A short row: fixed-size copies (inline moves, no library call), the
+                    // entries copied past the row's end dropped again.
+                    push_row(&mut out.x, &self.entry_x, slots.start, n);
+                    push_row(&mut out.y, &self.entry_y, slots.start, n);
+                    push_row(&mut out.z, &self.entry_z, slots.start, n);
+                    push_row(&mut out.index, &self.entry_index, slots.start, n);
+                    continue;
+                }
                 if by_coordinate {
                     out.x.extend_from_slice(&self.entry_x[slots.clone()]);
                     out.y.extend_from_slice(&self.entry_y[slots.clone()]);
@@ -335,6 +345,21 @@ impl SpatialGrid {
             }
         }
     }
+}
+
+/// Rows of at most this many entries are gathered by fixed-size copies.
+const SHORT_ROW: usize = 16;
+
+/// Appends `from[start..start + n]` to `out` (n ≤ [`SHORT_ROW`], `from` holding
+/// `start + SHORT_ROW` values) by copying a whole [`SHORT_ROW`] and dropping the excess.
+#[inline(always)]
+fn push_row<T: Copy>(out: &mut Vec<T>, from: &[T], start: usize, n: usize) {
+    let row: &[T; SHORT_ROW] = from[start..start + SHORT_ROW]
+        .try_into()
+        .unwrap_or_else(|_| unreachable!());
+    let len = out.len() + n;
+    out.extend_from_slice(row);
+    out.truncate(len);
 }
 
 /// Slack of row trimming in cells: far more than the rounding of a cell coordinate.
