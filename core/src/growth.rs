@@ -88,6 +88,8 @@ pub struct TreeMetrics {
 #[derive(Debug, Default)]
 pub(crate) struct Scratch {
     pub buds: Vec<buds::BudState>,
+    /// The attraction points each bud won, by bud.
+    pub won: Vec<buds::WonPoints>,
     /// Buds of node i are `buds[node_bud_start[i]..node_bud_start[i + 1]]`, terminal first.
     pub node_bud_start: Vec<u32>,
     pub positions: Vec<Vec3>,
@@ -100,8 +102,9 @@ pub(crate) struct Scratch {
     pub point_alive: Vec<bool>,
     /// Competing nodes near one cell of attraction points (colonization).
     pub candidates: crate::environment::Candidates,
-    /// The bud each attraction point feeds and its distance² (colonization).
-    pub point_winner: Vec<(u32, f32)>,
+    /// The bud each attraction point feeds and the unit vector from it to the point
+    /// (colonization).
+    pub point_winner: Vec<(u32, Vec3)>,
     /// The competing buds of entry i of `bud_grid` (a node; entries are numbered by slot, see
     /// [`crate::environment::SpatialGrid::number_entries_by_slot`]) are
     /// `competing_buds[competing_start[i]..competing_start[i + 1]]`, as (index in `buds`,

@@ -16,7 +16,6 @@ pub(crate) const TERMINAL: u32 = u32::MAX;
 pub(crate) struct BudState {
     pub node: u32,
     pub slot: u32,
-    pub position: Vec3,
     pub direction: Vec3,
     /// L: light exposure.
     pub light: f32,
@@ -24,11 +23,6 @@ pub(crate) struct BudState {
     pub q: f32,
     /// v: vigor reaching the bud.
     pub vigor: f32,
-    /// Σ unit vectors to the attraction points this bud won.
-    pub environment_sum: Vec3,
-    /// Σ tropism directions carried by those points.
-    pub tropism_sum: Vec3,
-    pub num_points: u32,
     pub enabled: bool,
     /// In the selective-growth mask (or no mask set).
     pub may_grow: bool,
@@ -105,14 +99,10 @@ pub(crate) fn collect(tree: &mut Tree, scratch: &mut Scratch) {
             scratch.buds.push(BudState {
                 node: i as u32,
                 slot,
-                position: node.end,
                 direction,
                 light: 0.0,
                 q: 0.0,
                 vigor: 0.0,
-                environment_sum: Vec3::ZERO,
-                tropism_sum: Vec3::ZERO,
-                num_points: 0,
                 enabled: false,
                 may_grow,
                 competes: may_grow,
@@ -143,6 +133,20 @@ pub(crate) fn collect(tree: &mut Tree, scratch: &mut Scratch) {
         }
     }
     scratch.node_bud_start.push(scratch.buds.len() as u32);
+    let num_buds = scratch.buds.len();
+    scratch.won.clear();
+    scratch.won.resize(num_buds, WonPoints::default());
+}
+
+/// What a bud won in the competition for space (step 2), kept apart from [`BudState`] so
+/// that the passes over every bud read less memory.
+#[derive(Clone, Copy, Debug, Default)]
+pub(crate) struct WonPoints {
+    /// Σ unit vectors to the attraction points this bud won.
+    pub environment_sum: Vec3,
+    /// Σ tropism directions carried by those points.
+    pub tropism_sum: Vec3,
+    pub count: u32,
 }
 
 /// Azimuth turn between successive nodes of an axis.

@@ -20,8 +20,8 @@ pub(crate) fn bud_input(tree: &Tree, scratch: &mut Scratch) -> usize {
     let s = &tree.species;
     let nodes = &tree.skeleton.internodes;
     let mut enabled = 0;
-    for bud in &mut scratch.buds {
-        bud.enabled = bud.num_points > 0;
+    for (bud, won) in scratch.buds.iter_mut().zip(&scratch.won) {
+        bud.enabled = won.count > 0;
         enabled += usize::from(bud.enabled);
         if !bud.enabled {
             bud.q = 0.0;

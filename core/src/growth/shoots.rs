@@ -154,8 +154,9 @@ fn grow_shoot(
         buds::first_bud_azimuth(parent_node)
     };
     let mut heading = bud.direction;
-    let mut environment = bud.environment_sum.try_normalize().unwrap_or(heading);
-    let mut carried = bud.tropism_sum.try_normalize();
+    let won = scratch.won[bi];
+    let mut environment = won.environment_sum.try_normalize().unwrap_or(heading);
+    let mut carried = won.tropism_sum.try_normalize();
     // What the tip perceived after the previous internode (none before the first).
     let mut perceived: Option<(Vec3, Option<Vec3>)> = None;
     for k in 0..n {

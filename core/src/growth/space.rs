@@ -17,7 +17,7 @@ use crate::environment::{AttractionPoints, SceneMode};
 use crate::rng::Rng;
 
 /// `Scratch::point_winner` of a point that no bud perceives.
-const NO_WINNER: (u32, f32) = (u32::MAX, 0.0);
+const NO_WINNER: (u32, Vec3) = (u32::MAX, Vec3::ZERO);
 
 /// Cell size of the bud grid relative to the perception radius.
 const PERCEPTION_CELL_FRACTION: f32 = 0.5;
@@ -104,9 +104,10 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
         let range = range[0] as usize..range[1] as usize;
         let buds = &scratch.buds[range.clone()];
         if let Some(first) = buds.iter().find(|b| b.competes)
-            && near(first.position, perception)
+            && let Some(position) = scratch.node_end.get(first.node as usize).copied()
+            && near(position, perception)
         {
-            scratch.positions.push(first.position);
+            scratch.positions.push(position);
             scratch
                 .competing_start
                 .push(scratch.competing_buds.len() as u32);
@@ -176,10 +177,12 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
                             [starts[ci as usize] as usize..starts[ci as usize + 1] as usize];
                         buds.iter()
                             .find(|(_, direction)| towards.dot(*direction) >= reach)
-                            .map(|&(bi, _)| bi)
+                            .map(|&(bi, _)| (bi, node_pos))
                     });
-            if let Some(winner) = best {
-                scratch.point_winner[pi as usize] = winner;
+            if let Some(((bi, node_pos), d2)) = best {
+                // The unit vector from the bud (at its node) to the point.
+                let towards = (position - node_pos) / d2.sqrt().max(1e-12);
+                scratch.point_winner[pi as usize] = (bi, towards);
             }
         }
     }
@@ -193,15 +196,15 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
             continue;
         }
         alive_count += 1;
-        let (bi, d2) = scratch.point_winner[pi];
+        let (bi, towards) = scratch.point_winner[pi];
         if bi == NO_WINNER.0 {
             continue;
         }
-        let bud = &mut scratch.buds[bi as usize];
-        bud.environment_sum += (point.position - bud.position) / d2.sqrt().max(1e-12);
-        bud.num_points += 1;
+        let won = &mut scratch.won[bi as usize];
+        won.environment_sum += towards;
+        won.count += 1;
         if let Some(t) = point.tropism {
-            bud.tropism_sum += t;
+            won.tropism_sum += t;
         }
     }
     alive_count
@@ -216,6 +219,7 @@ fn generate_points(tree: &mut Tree, scratch: &Scratch, r: f32, perception: f32, 
     let rng: &mut Rng = &mut tree.rng;
     points.points.reserve(scratch.buds.len() * 2);
     for bud in scratch.buds.iter().filter(|b| b.competes) {
+        let position = scratch.node_end[bud.node as usize];
         let count = 1 + (extra * (bud.light / s.full_exposure).clamp(0.0, 1.0)).round() as u32;
         let (b1, b2) = bud.direction.any_orthonormal_pair();
         for _ in 0..count {
@@ -226,7 +230,7 @@ fn generate_points(tree: &mut Tree, scratch: &Scratch, r: f32, perception: f32, 
             let (sa, ca) = rng.range_f32(0.0, std::f32::consts::TAU).sin_cos();
             let dir = cos_polar * bud.direction + sin_polar * (ca * b1 + sa * b2);
             let radius = (r3 + rng.next_f32() * (p3 - r3)).cbrt();
-            points.add_transient(bud.position + dir * radius);
+            points.add_transient(position + dir * radius);
         }
     }
 }
