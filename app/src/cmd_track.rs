@@ -66,10 +66,11 @@ pub fn track(args: TrackArgs) -> anyhow::Result<()> {
         report.ms_per_frame
     );
     println!(
-        "map: {} keyframes, {} points; scale from {:?}; {} frames skipped",
+        "map: {} keyframes, {} points; scale from {:?}; rolling-shutter readout {:.0} ms; {} frames skipped",
         report.num_keyframes,
         report.num_map_points,
         report.scale_source,
+        report.rolling_shutter_readout_ms,
         report.skipped.len()
     );
     if let Some(path) = &args.report {

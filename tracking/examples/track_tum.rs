@@ -17,8 +17,8 @@ fn main() {
     ) {
         Ok(report) => {
             eprintln!(
-                "keyframes={} points={}",
-                report.num_keyframes, report.num_map_points
+                "keyframes={} points={} readout_ms={}",
+                report.num_keyframes, report.num_map_points, report.rolling_shutter_readout_ms
             );
             if std::env::var_os("SYLVA_TRACE").is_some() {
                 for row in &report.trajectory {

@@ -22,6 +22,7 @@ pub mod lk;
 pub mod map;
 pub mod metrics;
 pub mod pose;
+pub mod rolling_shutter;
 pub mod scale;
 pub mod sequence;
 pub mod world;

@@ -4,7 +4,7 @@
 
 use crate::ba::{BaObservation, bundle_adjust, reprojection_error_px};
 use crate::cv;
-use crate::features::{Track, TrackOrigin, normalized, parallax_rad, triangulate};
+use crate::features::{Track, TrackOrigin, parallax_rad, triangulate};
 use crate::frame::{Frame, GrayImage};
 use crate::lk::{self, Pyramid};
 use crate::map::Observation;
@@ -57,7 +57,7 @@ impl Tracker {
                     Observation {
                         keyframe: kf,
                         pixel: track.pixel,
-                        normalized: normalized(&self.camera, track.pixel),
+                        normalized: self.normalized_rs(track.pixel),
                     },
                 );
             }
@@ -87,6 +87,20 @@ impl Tracker {
         Ok(())
     }
 
+    /// Adds this frame's evidence (its tracked map points) to the rolling-shutter readout
+    /// estimate.
+    pub(crate) fn estimate_readout(&mut self, pose: &Se3) {
+        let observations: Vec<(DVec3, Vec2)> = self
+            .tracks
+            .iter()
+            .filter_map(|t| Some((self.map.points.get(&t.point?)?.position, t.pixel)))
+            .collect();
+        let rate = self.shutter().rate;
+        let config = self.ba_config(5);
+        self.readout
+            .observe(&self.camera, pose, rate, &observations, &config);
+    }
+
     /// Candidates with enough parallax since their origin keyframe become map points.
     fn triangulate_candidates(&mut self, kf: usize, pose: &Se3) {
         let focal = self.camera.focal();
@@ -98,6 +112,7 @@ impl Tracker {
         // triangulated are not those whose noise happened to inflate their parallax (choosing
         // per point at the first threshold crossing makes every new point too near, and the map
         // shrinks keyframe after keyframe).
+        let shutter = self.shutter();
         let mut ready: HashMap<usize, bool> = HashMap::new();
         let mut dropped = Vec::new();
         for (i, track) in self.tracks.iter_mut().enumerate() {
@@ -106,7 +121,7 @@ impl Tracker {
                 continue;
             };
             let origin_pose = origin_kf.camera_from_world;
-            let n = self.camera.normalized_from_pixel(track.pixel.as_dvec2());
+            let n = shutter.normalized(&self.camera, track.pixel);
             if min_baseline > 0.0 {
                 let is_ready = *ready.entry(origin.keyframe).or_insert_with(|| {
                     let depth = median_depth(&self.map, origin.keyframe);
@@ -171,7 +186,7 @@ impl Tracker {
                 origin: Some(TrackOrigin {
                     keyframe: kf,
                     pixel,
-                    normalized: normalized(&self.camera, pixel),
+                    normalized: self.normalized_rs(pixel),
                 }),
             });
         }

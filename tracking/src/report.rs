@@ -53,6 +53,8 @@ pub struct TrackReport {
     pub num_map_points: usize,
     pub skipped: Vec<SkippedFrame>,
     pub scale_source: Option<crate::scale::ScaleSource>,
+    /// Rolling-shutter readout time used at the end of the run (given or estimated), ms.
+    pub rolling_shutter_readout_ms: f64,
     /// The ground plane in the world at the end of the run.
     pub plane: Option<crate::frame::Plane>,
     /// Per frame: index, timestamp, state, `world_from_camera` translation (if tracked).
@@ -210,6 +212,7 @@ fn summarise(
         num_map_points: tracker.map().points.len(),
         skipped,
         scale_source: tracker.world().map(|w| w.scale_source),
+        rolling_shutter_readout_ms: tracker.rolling_shutter_readout_s() * 1e3,
         plane: tracker.world().map(|w| w.plane_in_world()),
         trajectory,
         aligned,

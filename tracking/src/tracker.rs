@@ -12,6 +12,7 @@ use crate::initializer::Initializer;
 use crate::lk::{self, Pyramid, PyramidScratch};
 use crate::map::Map;
 use crate::pose::Se3;
+use crate::rolling_shutter::{ReadoutEstimate, RollingShutter};
 use crate::world::WorldFrame;
 use glam::{DAffine3, DVec2, DVec3, Vec2};
 use std::collections::{HashMap, HashSet};
@@ -69,6 +70,9 @@ pub struct TrackerConfig {
     pub max_local_search: usize,
     /// A keyframe at least every this many frames. Default 8.
     pub max_keyframe_gap: usize,
+    /// Rolling-shutter readout time, first row to last, seconds: `Some(0.0)` for a global
+    /// shutter; None (default) estimates it from the footage ([`crate::rolling_shutter`]).
+    pub rolling_shutter_readout_s: Option<f64>,
     /// Frames after a failure before `RecentlyLost` becomes `Lost`. Default 30.
     pub lost_after_frames: usize,
     /// Holding height for the metric scale, metres. Default 1.5.
@@ -96,6 +100,7 @@ impl Default for TrackerConfig {
             local_window: 8,
             max_local_search: 400,
             max_keyframe_gap: 8,
+            rolling_shutter_readout_s: None,
             lost_after_frames: 30,
             holding_height_m: crate::scale::DEFAULT_HOLDING_HEIGHT_M,
         }
@@ -135,6 +140,7 @@ pub struct Tracker {
     pub(crate) gravity_up: Option<DVec3>,
     pub(crate) late_poses: Vec<LatePose>,
     pub(crate) orb: OrbFeatures,
+    pub(crate) readout: ReadoutEstimate,
 }
 
 impl Tracker {
@@ -161,6 +167,7 @@ impl Tracker {
             gravity_up: None,
             late_poses: Vec::new(),
             orb: OrbFeatures::new(1000)?,
+            readout: ReadoutEstimate::default(),
         })
     }
 
@@ -225,7 +232,13 @@ impl Tracker {
                     old.recycle(&mut self.pyramid_scratch);
                 }
                 self.frames_since_keyframe += 1;
-                if self.needs_keyframe() {
+                let keyframe = self.needs_keyframe();
+                if self.config.rolling_shutter_readout_s.is_none()
+                    && (keyframe || self.readout.is_settling())
+                {
+                    self.estimate_readout(&pose);
+                }
+                if keyframe {
                     self.insert_keyframe(frame, pose)?;
                 }
                 let pose = self.prev_pose.unwrap_or(pose);
@@ -321,8 +334,8 @@ impl Tracker {
     }
 
     pub(crate) fn project(&self, camera_from_world: &Se3, point: DVec3) -> Option<Vec2> {
-        self.camera
-            .pixel_from_camera(camera_from_world.transform_point(point))
+        self.shutter()
+            .pixel(&self.camera, camera_from_world.transform_point(point))
             .filter(|p| self.camera.contains(*p, 4.0))
             .map(|p| p.as_vec2())
     }
@@ -335,6 +348,32 @@ impl Tracker {
         }
     }
 
+    /// The rolling-shutter model of the current frame: the readout given or estimated so far
+    /// (0 until the estimate has enough keyframes), the rotation rate of the last motion.
+    pub(crate) fn shutter(&self) -> RollingShutter {
+        let readout_s = self
+            .config
+            .rolling_shutter_readout_s
+            .or_else(|| self.readout.readout_s())
+            .unwrap_or(0.0);
+        let rate = if self.velocity_dt_s > 1e-6 {
+            self.velocity.rotation.to_scaled_axis() / self.velocity_dt_s
+        } else {
+            DVec3::ZERO
+        };
+        RollingShutter { rate, readout_s }
+    }
+
+    /// Normalised coordinates of `pixel` in the camera at the frame's middle row time.
+    pub(crate) fn normalized_rs(&self, pixel: Vec2) -> DVec2 {
+        self.shutter().normalized(&self.camera, pixel)
+    }
+
+    /// The readout time the tracker uses now, seconds (given, estimated, else 0).
+    pub fn rolling_shutter_readout_s(&self) -> f64 {
+        self.shutter().readout_s
+    }
+
     /// Pose from the tracks that see map points: robust refinement from `start`, PnP-RANSAC
     /// when that leaves too few inliers. Outlier tracks lose their point.
     fn estimate_pose(&mut self, start: Se3) -> Result<Option<Se3>, TrackerError> {
@@ -344,7 +383,7 @@ impl Tracker {
             .enumerate()
             .filter_map(|(i, t)| {
                 let p = self.map.points.get(&t.point?)?;
-                Some((i, p.position, normalized(&self.camera, t.pixel)))
+                Some((i, p.position, self.normalized_rs(t.pixel)))
             })
             .collect();
         if pairs.len() < self.config.min_pose_inliers {

@@ -21,6 +21,7 @@ pub fn config_from_env() -> sylva_tracking::TrackerConfig {
             "local_window" => config.local_window = v as usize,
             "max_local_search" => config.max_local_search = v as usize,
             "max_keyframe_gap" => config.max_keyframe_gap = v as usize,
+            "rolling_shutter_readout_s" => config.rolling_shutter_readout_s = Some(v),
             "lk_levels" => config.lk_levels = v as usize,
             "search_lk_levels" => config.search_lk_levels = v as usize,
             "search_fb_check" => config.search_fb_check = v != 0.0,
