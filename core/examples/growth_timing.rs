@@ -80,6 +80,7 @@ fn main() {
     let tree = grow_to_with(20_000, |_, _| {});
     let points = brush_points(&tree);
     let (mut best_wall, mut best_cpu) = (f64::INFINITY, f64::INFINITY);
+    let mut total_wall = 0.0;
     let repeats: u64 = std::env::var("SYLVA_BRUSH_REPEATS")
         .ok()
         .and_then(|v| v.parse().ok())
@@ -90,12 +91,15 @@ fn main() {
         next_brush_tree(i, &mut t, &tree, &points);
         let (w, c) = (Instant::now(), thread_cpu_ns());
         brush_iteration(&mut t);
-        best_wall = best_wall.min(w.elapsed().as_secs_f64() * 1e3);
+        let wall_ms = w.elapsed().as_secs_f64() * 1e3;
+        best_wall = best_wall.min(wall_ms);
+        total_wall += wall_ms;
         best_cpu = best_cpu.min(cpu_ms(c));
     }
     println!(
-        "brush iteration on {} internodes: best {best_wall:.2} ms wall, {best_cpu:.2} ms cpu",
-        tree.skeleton.len()
+        "brush iteration on {} internodes: best {best_wall:.2} ms wall, {best_cpu:.2} ms cpu, mean {:.2} ms wall",
+        tree.skeleton.len(),
+        total_wall / repeats.max(1) as f64
     );
     if digests {
         println!("  digest after {repeats} brush steps {}", digest(&t));

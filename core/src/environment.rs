@@ -11,6 +11,7 @@ mod scene;
 mod shadow;
 
 pub use attraction::{AttractionPoint, AttractionPoints};
+pub(crate) use grid::clear_with_room;
 pub use grid::{Candidates, SpatialGrid};
 pub use scene::{BoxScene, HalfSpace, Scene, SceneMode, SphereScene};
 pub use shadow::ShadowGrid;

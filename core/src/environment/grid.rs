@@ -10,6 +10,16 @@ use glam::{IVec3, Vec3};
 const MAX_CELLS_PER_POINT: usize = 4;
 const MIN_CELL_BUDGET: usize = 4096;
 
+/// Empties `v` with room for `n` values. A buffer too small is replaced (with a quarter more
+/// room) rather than grown: growing would copy contents that are about to be overwritten, into
+/// memory that is fresh either way.
+pub(crate) fn clear_with_room<T>(v: &mut Vec<T>, n: usize) {
+    v.clear();
+    if v.capacity() < n {
+        *v = Vec::with_capacity(n + n / 4);
+    }
+}
+
 #[derive(Clone, Debug, Default)]
 pub struct SpatialGrid {
     origin: Vec3,
@@ -43,13 +53,15 @@ impl SpatialGrid {
     }
 
     fn rebuild_with(&mut self, positions: &[Vec3], cell_size: f32, by_coordinate: bool) {
-        self.entry_index.clear();
-        self.entry_position.clear();
-        self.entry_x.clear();
-        self.entry_y.clear();
-        self.entry_z.clear();
+        let n = positions.len();
+        clear_with_room(&mut self.entry_index, n);
+        clear_with_room(&mut self.entry_position, n);
+        let coordinates = if by_coordinate { n } else { 0 };
+        clear_with_room(&mut self.entry_x, coordinates);
+        clear_with_room(&mut self.entry_y, coordinates);
+        clear_with_room(&mut self.entry_z, coordinates);
         self.cell_start.clear();
-        self.cell_of.clear();
+        clear_with_room(&mut self.cell_of, n);
         if positions.is_empty() {
             self.dims = IVec3::ZERO;
             self.cell_start.push(0);
@@ -72,6 +84,7 @@ impl SpatialGrid {
         self.inv_cell_size = 1.0 / cell;
         self.dims = ((extent * self.inv_cell_size).as_ivec3() + IVec3::ONE).max(IVec3::ONE);
         let num_cells = (self.dims.x * self.dims.y * self.dims.z) as usize;
+        clear_with_room(&mut self.cell_start, num_cells + 1);
         self.cell_start.resize(num_cells + 1, 0);
         for p in positions {
             let c = self.cell_index(self.cell_coord(*p));

@@ -5,6 +5,7 @@
 use glam::Vec3;
 
 use super::{Scratch, Tree};
+use crate::environment::clear_with_room;
 use crate::species::{Phyllotaxis, Species};
 use crate::tree::Internode;
 
@@ -62,10 +63,12 @@ pub(crate) fn collect(tree: &mut Tree, scratch: &mut Scratch) {
     scratch.expired_below = expired.max(cutoff.unwrap_or(0));
     scratch.expired_at = Some(tree.iteration);
     let nodes = &mut tree.skeleton.internodes;
-    scratch.buds.clear();
-    scratch.node_bud_start.clear();
-    scratch.node_end.clear();
-    scratch.in_mask.clear();
+    let n = nodes.len();
+    // About one living bud per node in a grown crown; a few more cost one copy.
+    clear_with_room(&mut scratch.buds, n);
+    clear_with_room(&mut scratch.node_bud_start, n + 1);
+    clear_with_room(&mut scratch.node_end, n);
+    clear_with_room(&mut scratch.in_mask, n);
     scratch
         .in_mask
         .resize(nodes.len(), tree.growth_mask.is_none());
@@ -134,7 +137,7 @@ pub(crate) fn collect(tree: &mut Tree, scratch: &mut Scratch) {
     }
     scratch.node_bud_start.push(scratch.buds.len() as u32);
     let num_buds = scratch.buds.len();
-    scratch.won.clear();
+    clear_with_room(&mut scratch.won, num_buds);
     scratch.won.resize(num_buds, WonPoints::default());
 }
 

@@ -13,7 +13,7 @@
 use glam::Vec3;
 
 use super::{Scratch, StepOptions, Tree};
-use crate::environment::{AttractionPoints, SceneMode};
+use crate::environment::{AttractionPoints, SceneMode, clear_with_room};
 use crate::rng::Rng;
 
 /// `Scratch::point_winner` of a point that no bud perceives.
@@ -65,7 +65,8 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
         p.cmpge(lo - Vec3::splat(margin)).all() && p.cmple(hi + Vec3::splat(margin)).all()
     };
     // Occupancy: every node (internode end) holds buds or did; its sphere takes points away.
-    scratch.positions.clear();
+    let room = scratch.node_end.len().max(points.len());
+    clear_with_room(&mut scratch.positions, room);
     scratch
         .positions
         .extend(scratch.node_end.iter().copied().filter(|&e| near(e, r)));
@@ -75,7 +76,7 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
     scratch.positions.clear();
     scratch.positions.extend(points.iter().map(|p| p.position));
     scratch.point_grid.rebuild(&scratch.positions, perception);
-    scratch.point_alive.clear();
+    clear_with_room(&mut scratch.point_alive, points.len());
     scratch.point_alive.resize(points.len(), false);
     // Cell by cell of the point grid: the nodes near the cell's points are gathered once, then
     // each point tests that short list (the same distances as a radius query of the node grid).
@@ -97,9 +98,9 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
     // nodes with at least one competing bud (a node's buds share its position, so one distance
     // serves them all; they are tried in bud order, as before); cells of half the perception
     // radius keep the scanned volume near the sphere's.
-    scratch.positions.clear();
-    scratch.competing_start.clear();
-    scratch.competing_buds.clear();
+    clear_with_room(&mut scratch.positions, scratch.node_end.len());
+    clear_with_room(&mut scratch.competing_start, scratch.node_end.len() + 1);
+    clear_with_room(&mut scratch.competing_buds, scratch.buds.len());
     for range in scratch.node_bud_start.windows(2) {
         let range = range[0] as usize..range[1] as usize;
         let buds = &scratch.buds[range.clone()];
@@ -127,8 +128,8 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
         .rebuild_for_gathers(&scratch.positions, PERCEPTION_CELL_FRACTION * perception);
     // The buds in the grid's cell order, the grid's entries renumbered to match: candidates
     // gathered from neighbouring cells then find their buds next to each other in memory.
-    scratch.sorted_start.clear();
-    scratch.sorted_buds.clear();
+    clear_with_room(&mut scratch.sorted_start, scratch.competing_start.len());
+    clear_with_room(&mut scratch.sorted_buds, scratch.competing_buds.len());
     for &i in scratch.bud_grid.entry_indices() {
         let i = i as usize;
         let range = scratch.competing_start[i] as usize..scratch.competing_start[i + 1] as usize;
@@ -144,7 +145,7 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
     // Each surviving point's winner (bud, distance²), found in the point grid's cell order, then
     // summed in point order (the order of the sums fixes their rounding).
     let (starts, competing) = (&scratch.competing_start, &scratch.competing_buds);
-    scratch.point_winner.clear();
+    clear_with_room(&mut scratch.point_winner, points.len());
     scratch.point_winner.resize(points.len(), NO_WINNER);
     // Cell by cell of the point grid: the competing nodes near the cell's points are gathered
     // once, then each point scans that short list.
