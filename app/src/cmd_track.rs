@@ -1,6 +1,6 @@
-//! `sylva track SEQUENCE [--report report.json] [--plot trajectory.png]`: runs the monocular
-//! tracker over a recorded TUM-layout sequence, prints per-stage timings and ends with one
-//! `key=value` line (error fields only when the sequence has ground truth).
+//! `sylva track SEQUENCE [--report report.json] [--plot trajectory.png] [--readout-ms MS]`:
+//! runs the monocular tracker over a recorded TUM-layout sequence, prints per-stage timings and
+//! ends with one `key=value` line (error fields only when the sequence has ground truth).
 
 #[cfg(not(any(target_os = "android", target_os = "ios")))]
 use anyhow::Context;
@@ -19,6 +19,22 @@ pub struct TrackArgs {
     /// Height the camera is held at above the ground, metres (sets the metric scale).
     #[arg(long, default_value_t = 1.5)]
     pub holding_height_m: f64,
+    /// Rolling-shutter readout time of the camera, first row to last, milliseconds (0 for a
+    /// global shutter); estimated from the footage when not given.
+    #[arg(long, value_parser = parse_readout_ms)]
+    pub readout_ms: Option<f64>,
+}
+
+/// A readout time in milliseconds: finite, 0 to 200.
+fn parse_readout_ms(text: &str) -> Result<f64, String> {
+    let ms: f64 = text
+        .parse()
+        .map_err(|_| format!("`{text}` is not a number of milliseconds"))?;
+    if ms.is_finite() && (0.0..=200.0).contains(&ms) {
+        Ok(ms)
+    } else {
+        Err(format!("readout {ms} ms is outside 0 to 200 ms"))
+    }
 }
 
 #[cfg(any(target_os = "android", target_os = "ios"))]
@@ -33,6 +49,7 @@ pub fn track(args: TrackArgs) -> anyhow::Result<()> {
 
     let config = sylva_tracking::TrackerConfig {
         holding_height_m: args.holding_height_m,
+        rolling_shutter_readout_s: args.readout_ms.map(|ms| ms / 1000.0),
         ..Default::default()
     };
     let bar = ProgressBar::new(0);
