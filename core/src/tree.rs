@@ -189,21 +189,7 @@ impl Skeleton {
             });
         }
         remap.resize(self.internodes.len(), None);
-        // Compact in place (each kept node renumbered, then moved once towards the front).
-        let mut read = 0;
-        self.internodes.retain_mut(|node| {
-            read += 1;
-            if remap[read - 1].is_none() {
-                return false;
-            }
-            node.parent = node.parent.and_then(|p| remap[p.index()]);
-            node.main_child = node.main_child.and_then(|c| remap[c.index()]);
-            node.lateral_children.retain(|c| remap[c.index()].is_some());
-            for c in &mut node.lateral_children {
-                *c = remap[c.index()].unwrap_or(*c);
-            }
-            true
-        });
+        self.compact(&remap, |_| {});
         remap
     }
 
@@ -215,7 +201,7 @@ impl Skeleton {
     pub(crate) fn remove_closed_flags(
         &mut self,
         removed: &[bool],
-        mut on_removed: impl FnMut(&Internode),
+        on_removed: impl FnMut(&Internode),
     ) -> Vec<Option<NodeId>> {
         let mut next = 0u32;
         let remap: Vec<Option<NodeId>> = (0..self.internodes.len())
@@ -228,6 +214,14 @@ impl Skeleton {
                 }
             })
             .collect();
+        self.compact(&remap, on_removed);
+        remap
+    }
+
+    /// Compacts the arena in place by `remap` (each kept internode renumbered, then moved once
+    /// towards the front; links to removed children dropped), handing every removed internode
+    /// to `on_removed` in arena order before dropping it.
+    fn compact(&mut self, remap: &[Option<NodeId>], mut on_removed: impl FnMut(&Internode)) {
         let mut read = 0;
         self.internodes.retain_mut(|node| {
             read += 1;
@@ -243,7 +237,6 @@ impl Skeleton {
             }
             true
         });
-        remap
     }
 
     /// Checks the arena invariants listed in the module doc.
