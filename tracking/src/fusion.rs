@@ -40,6 +40,7 @@ impl Tracker {
         let tracked: HashSet<u64> = self.tracks.iter().filter_map(|t| t.point).collect();
         // Projections of the described map points not tracked now, bucketed by grid cell.
         let mut grid: HashMap<(i32, i32), Vec<Projected>> = HashMap::new();
+        let shutter = self.shutter();
         for point in self.map.points.values() {
             let Some(descriptor) = point.descriptor else {
                 continue;
@@ -47,7 +48,7 @@ impl Tracker {
             if tracked.contains(&point.id) {
                 continue;
             }
-            if let Some(pixel) = self.project(pose, point.position) {
+            if let Some(pixel) = self.project(&shutter, pose, point.position) {
                 grid.entry(cell(pixel))
                     .or_default()
                     .push((point.id, pixel, descriptor));

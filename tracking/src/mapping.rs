@@ -50,6 +50,7 @@ impl Tracker {
             self.adopt_map_points(&frame.image, &pose)?;
         }
         let kf = self.map.add_keyframe(frame.index, pose);
+        let shutter = self.shutter();
         for track in &self.tracks {
             if let Some(id) = track.point {
                 self.map.add_observation(
@@ -57,7 +58,7 @@ impl Tracker {
                     Observation {
                         keyframe: kf,
                         pixel: track.pixel,
-                        normalized: self.normalized_rs(track.pixel),
+                        normalized: shutter.normalized(&self.camera, track.pixel),
                     },
                 );
             }
@@ -179,6 +180,7 @@ impl Tracker {
             self.config.min_corner_distance_px,
             &existing,
         )?;
+        let shutter = self.shutter();
         for pixel in corners {
             self.tracks.push(Track {
                 pixel,
@@ -186,7 +188,7 @@ impl Tracker {
                 origin: Some(TrackOrigin {
                     keyframe: kf,
                     pixel,
-                    normalized: self.normalized_rs(pixel),
+                    normalized: shutter.normalized(&self.camera, pixel),
                 }),
             });
         }
@@ -234,6 +236,7 @@ impl Tracker {
                 searchable[k] = Some(kf.center());
             }
         }
+        let shutter = self.shutter();
         let mut wanted: Vec<(usize, u64, Vec2, Vec2)> = Vec::new();
         // Cheapest tests first: most map points were last seen by keyframes without a pyramid.
         for point in self.map.points.values() {
@@ -253,7 +256,7 @@ impl Tracker {
             if angle.to_degrees() > 20.0 {
                 continue;
             }
-            let Some(projected) = self.project(pose, point.position) else {
+            let Some(projected) = self.project(&shutter, pose, point.position) else {
                 continue;
             };
             wanted.push((obs.keyframe, point.id, obs.pixel, projected));

@@ -283,10 +283,11 @@ impl Tracker {
             self.velocity
         };
         let predicted = velocity.compose(&prev_pose);
+        let shutter = self.shutter();
         let guesses: Vec<Vec2> = self
             .tracks
             .iter()
-            .map(|t| self.predict_pixel(t, &prev_pose, &predicted))
+            .map(|t| self.predict_pixel(&shutter, t, &prev_pose, &predicted))
             .collect();
         let from: Vec<Vec2> = self.tracks.iter().map(|t| t.pixel).collect();
         let moved = lk::track_points(
@@ -315,11 +316,17 @@ impl Tracker {
     }
 
     /// Where a track should appear under the predicted pose (rotation only for candidates).
-    fn predict_pixel(&self, track: &Track, prev: &Se3, predicted: &Se3) -> Vec2 {
+    fn predict_pixel(
+        &self,
+        shutter: &RollingShutter,
+        track: &Track,
+        prev: &Se3,
+        predicted: &Se3,
+    ) -> Vec2 {
         let in_prev_camera = match track.point.and_then(|id| self.map.points.get(&id)) {
             Some(point) => {
                 return self
-                    .project(predicted, point.position)
+                    .project(shutter, predicted, point.position)
                     .unwrap_or(track.pixel);
             }
             None => normalized(&self.camera, track.pixel).extend(1.0),
@@ -333,8 +340,15 @@ impl Tracker {
             .unwrap_or(track.pixel)
     }
 
-    pub(crate) fn project(&self, camera_from_world: &Se3, point: DVec3) -> Option<Vec2> {
-        self.shutter()
+    /// Where `point` appears in the frame at `camera_from_world` through `shutter` (from
+    /// [`Self::shutter`], taken once per frame by callers that project many points).
+    pub(crate) fn project(
+        &self,
+        shutter: &RollingShutter,
+        camera_from_world: &Se3,
+        point: DVec3,
+    ) -> Option<Vec2> {
+        shutter
             .pixel(&self.camera, camera_from_world.transform_point(point))
             .filter(|p| self.camera.contains(*p, 4.0))
             .map(|p| p.as_vec2())
@@ -364,11 +378,6 @@ impl Tracker {
         RollingShutter { rate, readout_s }
     }
 
-    /// Normalised coordinates of `pixel` in the camera at the frame's middle row time.
-    pub(crate) fn normalized_rs(&self, pixel: Vec2) -> DVec2 {
-        self.shutter().normalized(&self.camera, pixel)
-    }
-
     /// The readout time the tracker uses now, seconds (given, estimated, else 0).
     pub fn rolling_shutter_readout_s(&self) -> f64 {
         self.shutter().readout_s
@@ -377,13 +386,14 @@ impl Tracker {
     /// Pose from the tracks that see map points: robust refinement from `start`, PnP-RANSAC
     /// when that leaves too few inliers. Outlier tracks lose their point.
     fn estimate_pose(&mut self, start: Se3) -> Result<Option<Se3>, TrackerError> {
+        let shutter = self.shutter();
         let pairs: Vec<(usize, DVec3, DVec2)> = self
             .tracks
             .iter()
             .enumerate()
             .filter_map(|(i, t)| {
                 let p = self.map.points.get(&t.point?)?;
-                Some((i, p.position, self.normalized_rs(t.pixel)))
+                Some((i, p.position, shutter.normalized(&self.camera, t.pixel)))
             })
             .collect();
         if pairs.len() < self.config.min_pose_inliers {
