@@ -34,7 +34,8 @@ pub mod blackout {
     use std::ops::Range;
     use std::path::Path;
     use sylva_tracking::{
-        FrameOutput, FrameSource, GrayImage, SourceEvent, Tracker, TrackerConfig, TumSequence,
+        FrameOutput, FrameSource, GrayImage, SourceEvent, Tracker, TrackerConfig, TrackingState,
+        TumSequence,
     };
 
     /// Tracks the sequence at `root` frame by frame up to frame `end` (exclusive), with the
@@ -59,6 +60,23 @@ pub mod blackout {
             outputs.push(tracker.track(&frame, up.map(|u| u * 9.81)).expect("track"));
         }
         outputs
+    }
+
+    /// The first frame after `blank` that is tracked again, if any; panics when a blanked frame
+    /// was tracked.
+    pub fn recovery_frame(outputs: &[FrameOutput], blank: Range<usize>) -> Option<usize> {
+        for o in &outputs[blank.clone()] {
+            assert_ne!(
+                o.state,
+                TrackingState::Ok,
+                "blank frame {} tracked",
+                o.index
+            );
+        }
+        outputs[blank.end..]
+            .iter()
+            .find(|o| o.state == TrackingState::Ok)
+            .map(|o| o.index)
     }
 
     /// Camera-position distances, frame by frame from frame `from`, between two runs over the
