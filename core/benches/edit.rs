@@ -10,7 +10,7 @@ use sylva_core::edit::{
 };
 use sylva_core::growth::Tree;
 use sylva_core::species::Species;
-use sylva_core::tree::{Bud, Internode, NodeId, Skeleton};
+use sylva_core::tree::{Bud, Children, Internode, LateralBuds, NodeId, Skeleton};
 
 /// A 200-internode tapering trunk (0.1 m internodes) with a 3-internode branch every 5th node.
 fn trunk_200() -> (Skeleton, Vec<NodeId>) {
@@ -20,7 +20,7 @@ fn trunk_200() -> (Skeleton, Vec<NodeId>) {
     let node = |parent: Option<NodeId>, start: Vec3, dir: Vec3, diameter: f32| Internode {
         parent,
         main_child: None,
-        lateral_children: Vec::new(),
+        lateral_children: Children::new(),
         start,
         end: start + dir * 0.1,
         left: dir.any_orthonormal_vector(),
@@ -28,7 +28,7 @@ fn trunk_200() -> (Skeleton, Vec<NodeId>) {
         order: 0,
         born_iteration: 0,
         terminal_bud: Some(Bud::new(dir)),
-        lateral_buds: Vec::new(),
+        lateral_buds: LateralBuds::new(),
         width_constraint: None,
         light_exposure: 1.0,
     };

@@ -29,7 +29,7 @@ use serde::{Deserialize, Serialize};
 use crate::environment::{Environment, Scene, SceneMode, ShadowGrid};
 use crate::rng::Rng;
 use crate::species::Species;
-use crate::tree::{Bud, Internode, NodeId, Skeleton, TreeInvariantError};
+use crate::tree::{Bud, Children, Internode, LateralBuds, NodeId, Skeleton, TreeInvariantError};
 
 /// A growing tree: skeleton, species, environment and the generator that drives it.
 #[derive(Clone, Debug, Serialize, Deserialize)]
@@ -163,7 +163,7 @@ impl Tree {
         let mut seedling = Internode {
             parent: None,
             main_child: None,
-            lateral_children: Vec::new(),
+            lateral_children: Children::new(),
             start: Vec3::ZERO,
             end: Vec3::Y * l,
             left: Vec3::X,
@@ -171,7 +171,7 @@ impl Tree {
             order: 0,
             born_iteration: 0,
             terminal_bud: Some(Bud::new(Vec3::Y)),
-            lateral_buds: Vec::new(),
+            lateral_buds: LateralBuds::new(),
             width_constraint: None,
             light_exposure: tree.species.full_exposure,
         };

@@ -11,6 +11,7 @@
 
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
+use smallvec::SmallVec;
 
 use crate::rng::Rng;
 
@@ -23,6 +24,15 @@ impl NodeId {
         self.0 as usize
     }
 }
+
+/// The lateral children of an internode, in the arena: up to two held inline (one shoot per
+/// lateral bud, and most species have one or two per node), more on the heap. It saves as a list,
+/// like a `Vec`.
+pub type Children = SmallVec<[NodeId; 2]>;
+
+/// The lateral buds of an internode: up to two held inline, more on the heap. It saves as a
+/// list, like a `Vec`.
+pub type LateralBuds = SmallVec<[Bud; 2]>;
 
 /// A bud: the meristem that may produce a new shoot.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -55,7 +65,7 @@ pub struct Internode {
     /// The continuation of this axis (grown from the terminal bud), if any.
     pub main_child: Option<NodeId>,
     /// Shoots grown from this internode's lateral buds.
-    pub lateral_children: Vec<NodeId>,
+    pub lateral_children: Children,
     /// Base of the internode, world metres.
     pub start: Vec3,
     /// Tip of the internode, world metres.
@@ -72,7 +82,7 @@ pub struct Internode {
     /// The terminal bud, present while this internode is a tip.
     pub terminal_bud: Option<Bud>,
     /// Lateral (axillary) buds of this metamer.
-    pub lateral_buds: Vec<Bud>,
+    pub lateral_buds: LateralBuds,
     /// A user width constraint (diameter, metres) set on this internode.
     pub width_constraint: Option<f32>,
     /// Light exposure L of this metamer's buds at the last iteration (0 = full shade).

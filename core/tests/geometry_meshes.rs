@@ -8,7 +8,7 @@ use sylva_core::geometry::synthetic::{branching_skeleton, crown_ambient};
 use sylva_core::geometry::{
     FruitParams, LOD_TRIANGLE_FRACTIONS, MeshParams, TreeMesh, TreeMeshes, build_meshes,
 };
-use sylva_core::tree::{Bud, Internode, NodeId, Skeleton};
+use sylva_core::tree::{Bud, Children, Internode, NodeId, Skeleton};
 
 const SEED: u64 = 20_240_611;
 
@@ -96,7 +96,7 @@ fn node(parent: Option<u32>, start: Vec3, end: Vec3, diameter: f32) -> Internode
     Internode {
         parent: parent.map(NodeId),
         main_child: None,
-        lateral_children: Vec::new(),
+        lateral_children: Children::new(),
         start,
         end,
         left: Vec3::X,
@@ -104,7 +104,7 @@ fn node(parent: Option<u32>, start: Vec3, end: Vec3, diameter: f32) -> Internode
         order: 0,
         born_iteration: 0,
         terminal_bud: None,
-        lateral_buds: vec![Bud::new(Vec3::X)],
+        lateral_buds: std::iter::once(Bud::new(Vec3::X)).collect(),
         width_constraint: None,
         light_exposure: 1.0,
     }
@@ -144,10 +144,10 @@ fn crooked_skeleton() -> Skeleton {
         ), // near parallel
     ];
     nodes[0].main_child = Some(NodeId(1));
-    nodes[0].lateral_children = vec![NodeId(2)];
+    nodes[0].lateral_children = Children::from_slice(&[NodeId(2)]);
     nodes[2].main_child = Some(NodeId(3));
     nodes[3].main_child = Some(NodeId(4));
-    nodes[3].lateral_children = vec![NodeId(5), NodeId(6)];
+    nodes[3].lateral_children = Children::from_slice(&[NodeId(5), NodeId(6)]);
     Skeleton { internodes: nodes }
 }
 

@@ -8,7 +8,7 @@ use glam::Vec3;
 
 use super::any_perpendicular;
 use crate::rng::Rng;
-use crate::tree::{Bud, Internode, NodeId, Skeleton};
+use crate::tree::{Bud, Children, Internode, LateralBuds, NodeId, Skeleton};
 
 /// Parameters of [`branching_skeleton_with`]. Lengths in metres, angles in radians.
 #[derive(Clone, Debug, PartialEq)]
@@ -54,7 +54,7 @@ fn new_internode(
     Internode {
         parent,
         main_child: None,
-        lateral_children: Vec::new(),
+        lateral_children: Children::new(),
         start,
         end: start + heading * length,
         left,
@@ -62,7 +62,7 @@ fn new_internode(
         order,
         born_iteration: 0,
         terminal_bud: None,
-        lateral_buds: Vec::new(),
+        lateral_buds: LateralBuds::new(),
         width_constraint: None,
         light_exposure: 1.0,
     }
@@ -170,7 +170,7 @@ fn finish(nodes: &mut [Internode], params: &SyntheticParams, rng: &mut Rng) {
         let side = (heading + node.left).normalize_or(heading);
         let mut bud = Bud::new(side);
         bud.alive = node.lateral_children.is_empty();
-        node.lateral_buds = vec![bud];
+        node.lateral_buds = std::iter::once(bud).collect();
         // Outer, higher, thinner parts of the crown see more light.
         node.light_exposure =
             (0.25 + 0.5 * rng.next_f32() + 0.25 * (1.0 - diameter / 0.05).clamp(0.0, 1.0)).min(1.0);

@@ -146,14 +146,14 @@ impl Links {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::tree::NodeId;
+    use crate::tree::{Children, LateralBuds, NodeId};
     use glam::Vec3;
 
     fn node(parent: Option<u32>, start: Vec3, end: Vec3, diameter: f32) -> Internode {
         Internode {
             parent: parent.map(NodeId),
             main_child: None,
-            lateral_children: Vec::new(),
+            lateral_children: Children::new(),
             start,
             end,
             left: Vec3::X,
@@ -161,7 +161,7 @@ mod tests {
             order: 0,
             born_iteration: 0,
             terminal_bud: None,
-            lateral_buds: Vec::new(),
+            lateral_buds: LateralBuds::new(),
             width_constraint: None,
             light_exposure: 1.0,
         }
@@ -182,7 +182,7 @@ mod tests {
             ),
         ];
         nodes[0].main_child = Some(NodeId(1));
-        nodes[0].lateral_children = vec![NodeId(2)];
+        nodes[0].lateral_children = Children::from_slice(&[NodeId(2)]);
         nodes[2].main_child = Some(NodeId(3));
         let skeleton = Skeleton { internodes: nodes };
         skeleton.sanity_check().expect("valid test skeleton");

@@ -49,9 +49,9 @@ fn bud_cutoff(tree: &Tree) -> Option<u32> {
 pub(crate) fn collect(tree: &mut Tree, scratch: &mut Scratch) {
     let cutoff = bud_cutoff(tree);
     // Nodes born before `expired` had every lateral bud killed by an earlier pass of this tree
-    // (nothing revives a bud, and every node added since was born later): their bud vectors,
-    // a heap access per node, need no visit. A tree whose iteration did not simply advance
-    // since (a clone, a loaded or rewound tree starts with empty scratch) checks every node.
+    // (nothing revives a bud, and every node added since was born later): their lateral buds
+    // need no visit. A tree whose iteration did not simply advance since (a clone, a loaded or
+    // rewound tree starts with empty scratch) checks every node.
     let expired = if scratch
         .expired_at
         .is_some_and(|at| at + 1 == tree.iteration)
@@ -182,9 +182,6 @@ pub(crate) fn add_lateral_buds(species: &Species, node: &mut Internode, azimuth:
     let (sin_psi, cos_psi) = species.branching_angle_deg.to_radians().sin_cos();
     let k = species.buds_per_node();
     node.lateral_buds.clear();
-    // Exactly k: the vector is never extended, and a tight heap block keeps the per-iteration
-    // pass over every node's buds ([`collect`]) in fewer cache lines.
-    node.lateral_buds.reserve_exact(k as usize);
     for j in 0..k {
         let az = azimuth + j as f32 * std::f32::consts::TAU / k as f32;
         let (s, c) = az.sin_cos();

@@ -12,7 +12,7 @@ use super::buds::{self, TERMINAL};
 use super::space;
 use super::{Scratch, Tree};
 use crate::environment::{Scene, SceneMode};
-use crate::tree::{Bud, Internode, NodeId};
+use crate::tree::{Bud, Children, Internode, LateralBuds, NodeId};
 
 /// Upper bound on internodes in one shoot (guards absurd parameter values).
 const MAX_SHOOT_LENGTH: f32 = 200.0;
@@ -184,7 +184,7 @@ fn grow_shoot(
         let mut node = Internode {
             parent: Some(NodeId(parent as u32)),
             main_child: None,
-            lateral_children: Vec::new(),
+            lateral_children: Children::new(),
             start: tip,
             end,
             left: buds::transport_left(tree.skeleton.internodes[parent].left, new_heading),
@@ -192,7 +192,7 @@ fn grow_shoot(
             order,
             born_iteration: tree.iteration,
             terminal_bud: Some(Bud::new(new_heading)),
-            lateral_buds: Vec::new(),
+            lateral_buds: LateralBuds::new(),
             width_constraint: None,
             light_exposure: 0.0,
         };

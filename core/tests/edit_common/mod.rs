@@ -2,7 +2,7 @@
 #![allow(dead_code)]
 
 use glam::Vec3;
-use sylva_core::tree::{Bud, Internode, NodeId, Skeleton};
+use sylva_core::tree::{Bud, Children, Internode, NodeId, Skeleton};
 
 /// A fresh internode from `start` to `end` with a terminal bud and no children.
 pub fn internode(parent: Option<NodeId>, start: Vec3, end: Vec3, diameter: f32) -> Internode {
@@ -10,7 +10,7 @@ pub fn internode(parent: Option<NodeId>, start: Vec3, end: Vec3, diameter: f32) 
     Internode {
         parent,
         main_child: None,
-        lateral_children: Vec::new(),
+        lateral_children: Children::new(),
         start,
         end,
         left: heading.any_orthonormal_vector(),
@@ -18,7 +18,7 @@ pub fn internode(parent: Option<NodeId>, start: Vec3, end: Vec3, diameter: f32) 
         order: 0,
         born_iteration: 0,
         terminal_bud: Some(Bud::new(heading)),
-        lateral_buds: vec![Bud::new(heading.any_orthonormal_vector())],
+        lateral_buds: std::iter::once(Bud::new(heading.any_orthonormal_vector())).collect(),
         width_constraint: None,
         light_exposure: 1.0,
     }
