@@ -50,7 +50,7 @@ pub struct TrackerConfig {
     pub min_parallax_deg: f64,
     /// Candidates are triangulated once their origin keyframe's centre is this far from the
     /// current keyframe's, as a fraction of the origin's median scene depth (0: per-point
-    /// parallax test alone). Default 0.02.
+    /// parallax test alone). Default 0.01.
     pub min_baseline_ratio: f64,
     /// Whether keyframes attach candidate corners to old map points they re-find (ORB
     /// descriptors near the points' projections). Default true.
@@ -92,7 +92,7 @@ impl Default for TrackerConfig {
             huber_px: 1.5,
             min_parallax_deg: 0.25,
             init_min_parallax_deg: 1.0,
-            min_baseline_ratio: 0.02,
+            min_baseline_ratio: 0.01,
             adopt_map_points: true,
             adopt_radius_px: 4.0,
             init_min_points: 80,
