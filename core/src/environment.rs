@@ -6,13 +6,15 @@
 //! converted to metres by the caller.
 
 mod attraction;
+mod candidates;
 mod grid;
 mod scene;
 mod shadow;
 
 pub use attraction::{AttractionPoint, AttractionPoints};
+pub use candidates::Candidates;
+pub use grid::SpatialGrid;
 pub(crate) use grid::clear_with_room;
-pub use grid::{Candidates, SpatialGrid};
 pub use scene::{BoxScene, HalfSpace, Scene, SceneMode, SphereScene};
 pub use shadow::ShadowGrid;
 

@@ -6,6 +6,8 @@
 
 use glam::{IVec3, Vec3};
 
+use super::candidates::Candidates;
+
 /// At most this many cells per stored point (plus a constant): a sparse cloud gets bigger cells.
 const MAX_CELLS_PER_POINT: usize = 4;
 const MIN_CELL_BUDGET: usize = 4096;
@@ -46,7 +48,7 @@ impl SpatialGrid {
         self.rebuild_with(positions, cell_size, false);
     }
 
-    /// [`SpatialGrid::rebuild`] for a grid queried mostly by [`SpatialGrid::gather_box`]: it
+    /// [`SpatialGrid::rebuild`] for a grid queried mostly by [`SpatialGrid::gather_near`]: it
     /// also keeps the positions by coordinate, so that gathers copy whole rows of each.
     pub fn rebuild_for_gathers(&mut self, positions: &[Vec3], cell_size: f32) {
         self.rebuild_with(positions, cell_size, true);
@@ -205,39 +207,47 @@ impl SpatialGrid {
     }
 
     /// Gathers, in scan order, every stored point in the cells that overlap the box `lo..=hi`
-    /// (a superset of the points within the box) into `out`, replacing its contents.
-    pub fn gather_box(&self, lo: Vec3, hi: Vec3, out: &mut Candidates) {
+    /// grown by `radius` on every side (a superset of the points within `radius` of any point of
+    /// the box) into `out`, replacing its contents.
+    pub fn gather_near(&self, lo: Vec3, hi: Vec3, radius: f32, out: &mut Candidates) {
         out.clear();
-        let Some((lo, hi)) = self.cell_range(lo, hi) else {
+        let reach = Vec3::splat(radius);
+        let Some((cell_lo, cell_hi)) = self.cell_range(lo - reach, hi + reach) else {
+            out.pad();
             return;
         };
         let by_coordinate = self.has_coordinates();
-        for z in lo.z..=hi.z {
-            for y in lo.y..=hi.y {
-                let slots = self.row_slots(y, z, lo.x, hi.x);
+        for z in cell_lo.z..=cell_hi.z {
+            for y in cell_lo.y..=cell_hi.y {
+                let slots = self.row_slots(y, z, cell_lo.x, cell_hi.x);
                 let n = slots.len();
                 if by_coordinate && n <= SHORT_ROW && slots.start + SHORT_ROW <= self.len() {
                     // A short row: fixed-size copies (inline moves, no library call), the
                     // entries copied past the row's end dropped again.
-                    push_row(&mut out.x, &self.entry_x, slots.start, n);
-                    push_row(&mut out.y, &self.entry_y, slots.start, n);
-                    push_row(&mut out.z, &self.entry_z, slots.start, n);
-                    push_row(&mut out.index, &self.entry_index, slots.start, n);
-                    continue;
-                }
-                if by_coordinate {
-                    out.x.extend_from_slice(&self.entry_x[slots.clone()]);
-                    out.y.extend_from_slice(&self.entry_y[slots.clone()]);
-                    out.z.extend_from_slice(&self.entry_z[slots.clone()]);
+                    out.push_rows(
+                        [&self.entry_x, &self.entry_y, &self.entry_z],
+                        &self.entry_index,
+                        slots.start,
+                        n,
+                    );
+                } else if by_coordinate {
+                    out.extend_rows(
+                        [
+                            &self.entry_x[slots.clone()],
+                            &self.entry_y[slots.clone()],
+                            &self.entry_z[slots.clone()],
+                        ],
+                        &self.entry_index[slots],
+                    );
                 } else {
-                    let row = &self.entry_position[slots.clone()];
-                    out.x.extend(row.iter().map(|p| p.x));
-                    out.y.extend(row.iter().map(|p| p.y));
-                    out.z.extend(row.iter().map(|p| p.z));
+                    out.extend_positions(
+                        &self.entry_position[slots.clone()],
+                        &self.entry_index[slots],
+                    );
                 }
-                out.index.extend_from_slice(&self.entry_index[slots]);
             }
         }
+        out.pad();
     }
 
     /// The slots of cells `x0..=x1` of the row (`y`, `z`): cells along x are contiguous, so one
@@ -361,19 +371,7 @@ impl SpatialGrid {
 }
 
 /// Rows of at most this many entries are gathered by fixed-size copies.
-const SHORT_ROW: usize = 16;
-
-/// Appends `from[start..start + n]` to `out` (n ≤ [`SHORT_ROW`], `from` holding
-/// `start + SHORT_ROW` values) by copying a whole [`SHORT_ROW`] and dropping the excess.
-#[inline(always)]
-fn push_row<T: Copy>(out: &mut Vec<T>, from: &[T], start: usize, n: usize) {
-    let row: &[T; SHORT_ROW] = from[start..start + SHORT_ROW]
-        .try_into()
-        .unwrap_or_else(|_| unreachable!());
-    let len = out.len() + n;
-    out.extend_from_slice(row);
-    out.truncate(len);
-}
+const SHORT_ROW: usize = super::candidates::SHORT_ROW;
 
 /// Slack of row trimming in cells: far more than the rounding of a cell coordinate.
 const CELL_MARGIN: f32 = 1e-3;
@@ -391,142 +389,6 @@ fn axis_gap(c: f32, i: i32) -> f32 {
 pub(crate) fn floor_to_ivec3(v: Vec3) -> IVec3 {
     let t = v.as_ivec3();
     t - IVec3::select(v.cmplt(t.as_vec3()), IVec3::ONE, IVec3::ZERO)
-}
-
-/// Points gathered from a grid in its scan order ([`SpatialGrid::gather_box`]) as parallel
-/// arrays, so that many nearest-point queries around one place scan them linearly.
-#[derive(Clone, Debug, Default)]
-pub struct Candidates {
-    x: Vec<f32>,
-    y: Vec<f32>,
-    z: Vec<f32>,
-    index: Vec<u32>,
-    d2: Vec<f32>,
-}
-
-impl Candidates {
-    fn clear(&mut self) {
-        self.x.clear();
-        self.y.clear();
-        self.z.clear();
-        self.index.clear();
-    }
-
-    pub fn len(&self) -> usize {
-        self.index.len()
-    }
-
-    pub fn is_empty(&self) -> bool {
-        self.index.is_empty()
-    }
-
-    /// For a query whose sphere lies inside the gathered box: true when some gathered point lies
-    /// within `radius` of `center`, with distances computed exactly as the grid computes them
-    /// (so the answer is [`SpatialGrid::any_within`]'s).
-    pub fn any_within(&self, center: Vec3, radius: f32) -> bool {
-        const LANES: usize = 8;
-        let r2 = radius * radius;
-        let mut lanes = [f32::INFINITY; LANES];
-        let (xs, ys, zs) = (
-            self.x.chunks_exact(LANES),
-            self.y.chunks_exact(LANES),
-            self.z.chunks_exact(LANES),
-        );
-        let tail = (xs.remainder(), ys.remainder(), zs.remainder());
-        for ((x, y), z) in xs.zip(ys).zip(zs) {
-            for k in 0..LANES {
-                // (p − c)·(p − c), as glam's `distance_squared` sums it.
-                let (dx, dy, dz) = (x[k] - center.x, y[k] - center.y, z[k] - center.z);
-                let d2 = dx * dx + dy * dy + dz * dz;
-                lanes[k] = if d2 < lanes[k] { d2 } else { lanes[k] };
-            }
-        }
-        for (((m, &x), &y), &z) in lanes.iter_mut().zip(tail.0).zip(tail.1).zip(tail.2) {
-            let (dx, dy, dz) = (x - center.x, y - center.y, z - center.z);
-            let d2 = dx * dx + dy * dy + dz * dz;
-            *m = if d2 < *m { d2 } else { *m };
-        }
-        lanes.iter().any(|&d2| d2 <= r2)
-    }
-
-    /// For a query whose sphere lies inside the gathered box: the nearest point within `radius`
-    /// of `center` that `accept(index, position, distance²)` takes (it returns what to report),
-    /// with its distance²; among equally near points the first that
-    /// [`SpatialGrid::for_each_within`] visits. Distances are computed exactly as the grid
-    /// computes them.
-    pub fn nearest_accepted<T>(
-        &mut self,
-        center: Vec3,
-        radius: f32,
-        mut accept: impl FnMut(u32, Vec3, f32) -> Option<T>,
-    ) -> Option<(T, f32)> {
-        let r2 = radius * radius;
-        self.d2.clear();
-        self.d2.extend(
-            self.x
-                .iter()
-                .zip(&self.y)
-                .zip(&self.z)
-                .map(|((&x, &y), &z)| {
-                    // (p − c)·(p − c), as glam's `distance_squared` sums it.
-                    let (dx, dy, dz) = (x - center.x, y - center.y, z - center.z);
-                    dx * dx + dy * dy + dz * dz
-                }),
-        );
-        loop {
-            // The smallest distance left, then its first point (ties go to the first).
-            let nearest = min_of(&self.d2);
-            if nearest > r2 || nearest == f32::INFINITY {
-                return None;
-            }
-            let j = first_equal(&self.d2, nearest)?;
-            let p = Vec3::new(self.x[j], self.y[j], self.z[j]);
-            if let Some(found) = accept(self.index[j], p, nearest) {
-                return Some((found, nearest));
-            }
-            // Refused: never the nearest again.
-            self.d2[j] = f32::INFINITY;
-        }
-    }
-}
-
-/// The first index holding `value`, eight values at a time (one packed compare and one branch
-/// per eight, instead of a branch per value).
-fn first_equal(values: &[f32], value: f32) -> Option<usize> {
-    const LANES: usize = 8;
-    let chunks = values.chunks_exact(LANES);
-    let rest = chunks.remainder();
-    for (c, chunk) in chunks.enumerate() {
-        let mut bits = 0u32;
-        for (k, &d) in chunk.iter().enumerate() {
-            bits |= u32::from(d == value) << k;
-        }
-        if bits != 0 {
-            return Some(c * LANES + bits.trailing_zeros() as usize);
-        }
-    }
-    let tail = values.len() - rest.len();
-    rest.iter().position(|&d| d == value).map(|k| tail + k)
-}
-
-/// The smallest value (∞ for none; NaNs ignored), in eight independent lanes so that it
-/// compiles to packed minimums.
-fn min_of(values: &[f32]) -> f32 {
-    const LANES: usize = 8;
-    let mut lanes = [f32::INFINITY; LANES];
-    let chunks = values.chunks_exact(LANES);
-    let rest = chunks.remainder();
-    for chunk in chunks {
-        for (m, &d) in lanes.iter_mut().zip(chunk) {
-            *m = if d < *m { d } else { *m };
-        }
-    }
-    for (m, &d) in lanes.iter_mut().zip(rest) {
-        *m = if d < *m { d } else { *m };
-    }
-    lanes
-        .iter()
-        .fold(f32::INFINITY, |m, &d| if d < m { d } else { m })
 }
 
 #[cfg(test)]
@@ -551,111 +413,6 @@ mod tests {
                 .collect();
             assert_eq!(found, expected);
         }
-    }
-
-    /// The first strictly nearest accepted point in the grid's scan order (the reference).
-    fn first_nearest_accepted(
-        grid: &SpatialGrid,
-        center: Vec3,
-        radius: f32,
-        accept: impl Fn(u32, Vec3, f32) -> Option<u32>,
-    ) -> Option<(u32, f32)> {
-        let mut best: Option<(u32, f32)> = None;
-        grid.for_each_within(center, radius, |i, p, d2| {
-            if best.is_none_or(|(_, bd)| d2 < bd)
-                && let Some(found) = accept(i, p, d2)
-            {
-                best = Some((found, d2));
-            }
-        });
-        best
-    }
-
-    #[test]
-    fn gathered_candidates_answer_nearest_queries_like_the_grid() {
-        let mut rng = Rng::new(13);
-        let mut points: Vec<Vec3> = (0..3000).map(|_| rng.in_unit_ball() * 2.0).collect();
-        for i in 0..300 {
-            points.push(Vec3::new((i % 6) as f32, (i / 6 % 5) as f32, (i / 30) as f32) * 0.2);
-        }
-        let mut grid = SpatialGrid::default();
-        grid.rebuild(&points, 0.2);
-        // Gathers from a grid that keeps positions by coordinate and from one that does not.
-        let mut by_coordinate = SpatialGrid::default();
-        by_coordinate.rebuild_for_gathers(&points, 0.2);
-        let mut candidates = Candidates::default();
-        for q in 0..200 {
-            let radius = rng.range_f32(0.05, 0.5);
-            // Every fourth query box starts between lattice points (exact distance ties).
-            let lo = if q % 4 == 0 {
-                Vec3::new((q % 5) as f32, (q % 4) as f32, (q % 7) as f32) * 0.2 + Vec3::splat(0.1)
-            } else {
-                rng.in_unit_ball() * 2.0
-            };
-            let hi = lo + Vec3::splat(rng.range_f32(0.0, 0.4));
-            [&grid, &by_coordinate][q % 2].gather_box(
-                lo - Vec3::splat(radius),
-                hi + Vec3::splat(radius),
-                &mut candidates,
-            );
-            for k in 0..5 {
-                let t = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32());
-                let center = if k == 0 { lo } else { lo + (hi - lo) * t };
-                let accept = |i: u32, _: Vec3, _: f32| (i % 3 != 1).then_some(i);
-                assert_eq!(
-                    candidates.nearest_accepted(center, radius, accept),
-                    first_nearest_accepted(&grid, center, radius, accept),
-                );
-            }
-        }
-    }
-
-    #[test]
-    fn gathered_candidates_answer_occupancy_queries_like_the_grid() {
-        let mut rng = Rng::new(17);
-        let mut points: Vec<Vec3> = (0..2000).map(|_| rng.in_unit_ball() * 2.0).collect();
-        // Points exactly at the query radius from lattice centres (boundary cases).
-        for i in 0..50 {
-            points.push(Vec3::new(i as f32 * 0.1, 0.25, 0.0));
-        }
-        let mut grid = SpatialGrid::default();
-        grid.rebuild(&points, 0.3);
-        // Gathers from a grid that keeps positions by coordinate and from one that does not.
-        let mut by_coordinate = SpatialGrid::default();
-        by_coordinate.rebuild_for_gathers(&points, 0.3);
-        let mut candidates = Candidates::default();
-        let (mut inside, mut outside) = (0, 0);
-        for q in 0..300 {
-            let radius = if q % 3 == 0 {
-                0.25
-            } else {
-                rng.range_f32(0.01, 0.4)
-            };
-            let lo = if q % 3 == 0 {
-                Vec3::new((q % 40) as f32 * 0.1, 0.0, 0.0)
-            } else {
-                rng.in_unit_ball() * 2.5
-            };
-            let hi = lo + Vec3::splat(rng.range_f32(0.0, 0.3));
-            let reach = Vec3::splat(radius);
-            [&grid, &by_coordinate][q % 2].gather_box(lo - reach, hi + reach, &mut candidates);
-            for k in 0..4 {
-                let t = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32());
-                let center = if k == 0 { lo } else { lo + (hi - lo) * t };
-                let expected = grid.any_within(center, radius);
-                assert_eq!(
-                    candidates.any_within(center, radius),
-                    expected,
-                    "{center} {radius}"
-                );
-                if expected {
-                    inside += 1;
-                } else {
-                    outside += 1;
-                }
-            }
-        }
-        assert!(inside > 100 && outside > 100, "{inside} {outside}");
     }
 
     #[test]
@@ -702,11 +459,11 @@ mod tests {
         let reordered: Vec<Vec3> = order.iter().map(|&i| points[i as usize]).collect();
         let mut candidates = Candidates::default();
         let (lo, hi) = (Vec3::splat(-0.7), Vec3::splat(0.4));
-        renumbered.gather_box(lo, hi, &mut candidates);
-        let by_slot: Vec<u32> = candidates.index.clone();
-        grid.gather_box(lo, hi, &mut candidates);
+        renumbered.gather_near(lo, hi, 0.0, &mut candidates);
+        let by_slot: Vec<u32> = candidates.indices().to_vec();
+        grid.gather_near(lo, hi, 0.0, &mut candidates);
         assert!(by_slot.len() > 20);
-        for (slot, original) in by_slot.iter().zip(&candidates.index) {
+        for (slot, original) in by_slot.iter().zip(candidates.indices()) {
             assert_eq!(order[*slot as usize], *original);
             assert_eq!(reordered[*slot as usize], points[*original as usize]);
         }

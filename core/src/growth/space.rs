@@ -75,7 +75,9 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
     // order also orders the queries below so that neighbouring queries share cached cells.
     scratch.positions.clear();
     scratch.positions.extend(points.iter().map(|p| p.position));
-    scratch.point_grid.rebuild(&scratch.positions, perception);
+    scratch
+        .point_grid
+        .rebuild_for_gathers(&scratch.positions, perception);
     clear_with_room(&mut scratch.point_alive, points.len());
     scratch.point_alive.resize(points.len(), false);
     // Cell by cell of the point grid: the nodes near the cell's points are gathered once, then
@@ -86,10 +88,9 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
             lo = lo.min(p);
             hi = hi.max(p);
         }
-        let reach = Vec3::splat(r);
         scratch
             .node_grid
-            .gather_box(lo - reach, hi + reach, &mut scratch.candidates);
+            .gather_near(lo, hi, r, &mut scratch.candidates);
         for (&pi, &position) in cell.iter().zip(positions) {
             scratch.point_alive[pi as usize] = !scratch.candidates.any_within(position, r);
         }
@@ -160,10 +161,9 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
         if lo.x > hi.x {
             continue;
         }
-        let reach = Vec3::splat(perception);
         scratch
             .bud_grid
-            .gather_box(lo - reach, hi + reach, &mut scratch.candidates);
+            .gather_near(lo, hi, perception, &mut scratch.candidates);
         for (&pi, &position) in cell.iter().zip(positions) {
             if !scratch.point_alive[pi as usize] {
                 continue;
@@ -250,7 +250,6 @@ pub(crate) fn consume_and_perceive(
     let (_, perception, cos_half) = radii(tree);
     let consume_r2 = r * r;
     let points = &tree.environment.attraction.points;
-    let alive = &mut scratch.point_alive;
     let mut sum = Vec3::ZERO;
     let mut tropism = Vec3::ZERO;
     let mut count = 0;
@@ -260,9 +259,16 @@ pub(crate) fn consume_and_perceive(
     let margin = Vec3::splat(BOX_MARGIN * perception);
     let lo = tip + cone_lo.min(Vec3::splat(-r)) - margin;
     let hi = tip + cone_hi.max(Vec3::splat(r)) + margin;
+    // The points of the cells there, then the scan of them within the perception radius.
+    let reach = Vec3::splat(perception);
+    let (lo, hi) = (lo.max(tip - reach), hi.min(tip + reach));
     scratch
         .point_grid
-        .for_each_within_box(tip, perception, lo, hi, |pi, p, d2| {
+        .gather_near(lo, hi, 0.0, &mut scratch.candidates);
+    let alive = &mut scratch.point_alive;
+    scratch
+        .candidates
+        .for_each_within(tip, perception, |pi, p, d2| {
             if d2 <= consume_r2 {
                 alive[pi as usize] = false;
                 return;
@@ -318,9 +324,12 @@ fn cone_bounds(axis: Vec3, cos_half: f32, radius: f32) -> (Vec3, Vec3) {
 
 /// Marks the points within the occupancy sphere of a new node as consumed.
 pub(crate) fn consume(scratch: &mut Scratch, node_end: Vec3, r: f32) {
-    let alive = &mut scratch.point_alive;
     scratch
         .point_grid
+        .gather_near(node_end, node_end, r, &mut scratch.candidates);
+    let alive = &mut scratch.point_alive;
+    scratch
+        .candidates
         .for_each_within(node_end, r, |pi, _, _| alive[pi as usize] = false);
 }
 
