@@ -253,6 +253,16 @@ mod tests {
     use crate::environment::SpatialGrid;
     use crate::rng::Rng;
 
+    /// `count` query centres in the box `lo..=hi`: its low corner, then random points inside.
+    fn centres_in(rng: &mut Rng, lo: Vec3, hi: Vec3, count: usize) -> Vec<Vec3> {
+        (0..count)
+            .map(|k| {
+                let t = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32());
+                if k == 0 { lo } else { lo + (hi - lo) * t }
+            })
+            .collect()
+    }
+
     /// The first strictly nearest accepted point in the grid's scan order (the reference).
     fn first_nearest_accepted(
         grid: &SpatialGrid,
@@ -294,9 +304,7 @@ mod tests {
             };
             let hi = lo + Vec3::splat(rng.range_f32(0.0, 0.4));
             [&grid, &by_coordinate][q % 2].gather_near(lo, hi, radius, &mut candidates);
-            for k in 0..5 {
-                let t = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32());
-                let center = if k == 0 { lo } else { lo + (hi - lo) * t };
+            for center in centres_in(&mut rng, lo, hi, 5) {
                 let accept = |i: u32, _: Vec3, _: f32| (i % 3 != 1).then_some(i);
                 assert_eq!(
                     candidates.nearest_accepted(center, radius, accept),
@@ -334,9 +342,7 @@ mod tests {
             };
             let hi = lo + Vec3::splat(rng.range_f32(0.0, 0.3));
             [&grid, &by_coordinate][q % 2].gather_near(lo, hi, radius, &mut candidates);
-            for k in 0..4 {
-                let t = Vec3::new(rng.next_f32(), rng.next_f32(), rng.next_f32());
-                let center = if k == 0 { lo } else { lo + (hi - lo) * t };
+            for center in centres_in(&mut rng, lo, hi, 4) {
                 let expected = grid.any_within(center, radius);
                 assert_eq!(
                     candidates.any_within(center, radius),
@@ -361,15 +367,18 @@ mod tests {
         grid.rebuild_for_gathers(&points, 0.3);
         let mut candidates = Candidates::default();
         let mut visited = 0;
-        for _ in 0..200 {
-            let center = rng.in_unit_ball() * 2.2;
+        for _ in 0..100 {
+            let lo = rng.in_unit_ball() * 2.2;
+            let hi = lo + Vec3::splat(rng.range_f32(0.0, 0.3));
             let radius = rng.range_f32(0.05, 0.6);
-            grid.gather_near(center, center, radius, &mut candidates);
-            let (mut expected, mut got) = (Vec::new(), Vec::new());
-            grid.for_each_within(center, radius, |i, p, d2| expected.push((i, p, d2)));
-            candidates.for_each_within(center, radius, |i, p, d2| got.push((i, p, d2)));
-            visited += got.len();
-            assert_eq!(got, expected);
+            grid.gather_near(lo, hi, radius, &mut candidates);
+            for center in centres_in(&mut rng, lo, hi, 3) {
+                let (mut expected, mut got) = (Vec::new(), Vec::new());
+                grid.for_each_within(center, radius, |i, p, d2| expected.push((i, p, d2)));
+                candidates.for_each_within(center, radius, |i, p, d2| got.push((i, p, d2)));
+                visited += got.len();
+                assert_eq!(got, expected);
+            }
         }
         assert!(visited > 1000, "{visited}");
     }
