@@ -278,25 +278,6 @@ impl SpatialGrid {
         );
     }
 
-    /// [`SpatialGrid::for_each_within`] limited to the cells that overlap the box `lo..=hi`
-    /// (world coordinates): the same calls in the same order, except for points in cells
-    /// outside the box, which the caller knows it does not need.
-    pub fn for_each_within_box(
-        &self,
-        center: Vec3,
-        radius: f32,
-        lo: Vec3,
-        hi: Vec3,
-        mut f: impl FnMut(u32, Vec3, f32),
-    ) {
-        let reach = Vec3::splat(radius);
-        let (lo, hi) = (lo.max(center - reach), hi.min(center + reach));
-        self.scan_box(center, radius, lo, hi, |slot, p, d2| {
-            f(self.entry_index[slot], p, d2);
-            false
-        });
-    }
-
     /// True when some stored point lies within `radius` of `center` (stops at the first).
     pub fn any_within(&self, center: Vec3, radius: f32) -> bool {
         let mut found = false;
