@@ -17,6 +17,19 @@ pub enum ScaleSource {
     KnownDistance { distance_m: f64 },
 }
 
+impl std::fmt::Display for ScaleSource {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Self::CameraHeight { holding_height_m } => {
+                write!(f, "the camera's height (held {holding_height_m} m above the ground)")
+            }
+            Self::KnownDistance { distance_m } => {
+                write!(f, "two picked points {distance_m} m apart")
+            }
+        }
+    }
+}
+
 /// Metres per map unit from the camera centre's height above the plane. None when the camera
 /// is (almost) on the plane.
 pub fn scale_from_camera_height(
