@@ -86,9 +86,10 @@ pub fn track(args: TrackArgs) -> anyhow::Result<()> {
         "map: {} keyframes, {} points; scale from {}; rolling-shutter readout {:.0} ms; {} frames skipped",
         report.num_keyframes,
         report.num_map_points,
-        report
-            .scale_source
-            .map_or_else(|| "nothing (no ground plane found)".to_owned(), |s| s.to_string()),
+        report.scale_source.map_or_else(
+            || "nothing (no ground plane found)".to_owned(),
+            |s| s.to_string()
+        ),
         report.rolling_shutter_readout_ms,
         report.skipped.len()
     );

@@ -21,7 +21,10 @@ impl std::fmt::Display for ScaleSource {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         match self {
             Self::CameraHeight { holding_height_m } => {
-                write!(f, "the camera's height (held {holding_height_m} m above the ground)")
+                write!(
+                    f,
+                    "the camera's height (held {holding_height_m} m above the ground)"
+                )
             }
             Self::KnownDistance { distance_m } => {
                 write!(f, "two picked points {distance_m} m apart")
