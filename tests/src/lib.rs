@@ -38,9 +38,39 @@ pub mod blackout {
         TumSequence,
     };
 
+    /// A forced loss and what came after it.
+    pub struct Recovery {
+        /// The first frame after the blank that is tracked again.
+        pub frame: usize,
+        /// Camera-position distances, frame by frame from the recovery on, between the run with
+        /// the blank and the unbroken run (frames with a pose in both), sorted.
+        pub offsets: Vec<f64>,
+    }
+
+    impl Recovery {
+        /// The median of [`Recovery::offsets`], metres.
+        pub fn median_offset_m(&self) -> f64 {
+            self.offsets
+                .get(self.offsets.len() / 2)
+                .copied()
+                .unwrap_or(f64::INFINITY)
+        }
+    }
+
+    /// Tracks the sequence at `root` up to frame `end` (exclusive) twice, unbroken and with the
+    /// frames in `blank` turned black, and compares the worlds after the recovery; None when
+    /// tracking never came back after the blank. Panics when a blanked frame was tracked.
+    pub fn blank_and_recover(root: &Path, blank: Range<usize>, end: usize) -> Option<Recovery> {
+        let clean = track_blanking(root, 0..0, end);
+        let lost = track_blanking(root, blank.clone(), end);
+        let frame = recovery_frame(&lost, blank)?;
+        let offsets = world_offsets(&lost, &clean, frame);
+        Some(Recovery { frame, offsets })
+    }
+
     /// Tracks the sequence at `root` frame by frame up to frame `end` (exclusive), with the
     /// frames in `blank` turned black.
-    pub fn track_blanking(root: &Path, blank: Range<usize>, end: usize) -> Vec<FrameOutput> {
+    fn track_blanking(root: &Path, blank: Range<usize>, end: usize) -> Vec<FrameOutput> {
         let sequence =
             TumSequence::open(root).unwrap_or_else(|e| panic!("{} is needed: {e}", root.display()));
         let mut source = sequence.source();
@@ -64,7 +94,7 @@ pub mod blackout {
 
     /// The first frame after `blank` that is tracked again, if any; panics when a blanked frame
     /// was tracked.
-    pub fn recovery_frame(outputs: &[FrameOutput], blank: Range<usize>) -> Option<usize> {
+    fn recovery_frame(outputs: &[FrameOutput], blank: Range<usize>) -> Option<usize> {
         for o in &outputs[blank.clone()] {
             assert_ne!(
                 o.state,
@@ -81,7 +111,7 @@ pub mod blackout {
 
     /// Camera-position distances, frame by frame from frame `from`, between two runs over the
     /// same footage (frames with a pose in both), sorted.
-    pub fn world_offsets(lost: &[FrameOutput], clean: &[FrameOutput], from: usize) -> Vec<f64> {
+    fn world_offsets(lost: &[FrameOutput], clean: &[FrameOutput], from: usize) -> Vec<f64> {
         let mut offsets: Vec<f64> = lost
             .iter()
             .zip(clean)

@@ -3,7 +3,6 @@
 //! against the keyframes'); the tracker must relocalise in its own map within a few frames.
 
 use sylva_tests::{blackout, shared_data_dir};
-use sylva_tracking::FrameOutput;
 
 /// Frames blanked: one second at 30 Hz.
 const BLANK: std::ops::Range<usize> = 300..330;
@@ -12,31 +11,24 @@ const RECOVERY_FRAMES: usize = 8;
 /// Frames after recovery compared with the unbroken run.
 const COMPARED_FRAMES: usize = 60;
 
-/// Tracks fr1_rpy frame by frame up to the compared frames, blanking the frames in `blank`.
-fn track_blanking(blank: std::ops::Range<usize>) -> Vec<FrameOutput> {
-    let end = BLANK.end + RECOVERY_FRAMES + COMPARED_FRAMES;
-    blackout::track_blanking(&shared_data_dir().join("tum_fr1_rpy"), blank, end)
-}
-
 #[test]
 fn after_a_forced_one_second_loss_on_real_footage_tracking_relocalises_in_the_same_world() {
-    let clean = track_blanking(0..0);
-    let lost = track_blanking(BLANK);
-    let recovered =
-        blackout::recovery_frame(&lost, BLANK).expect("tracking never came back after the blank");
+    let end = BLANK.end + RECOVERY_FRAMES + COMPARED_FRAMES;
+    // Camera positions after recovery, frame by frame, against the unbroken run's in the same
+    // world (before the blank both runs are the same computation).
+    let recovery = blackout::blank_and_recover(&shared_data_dir().join("tum_fr1_rpy"), BLANK, end)
+        .expect("tracking never came back after the blank");
+    let recovered = recovery.frame;
     assert!(
         recovered < BLANK.end + RECOVERY_FRAMES,
         "tracking came back only at frame {recovered}"
     );
-    // Camera positions after recovery, frame by frame, against the unbroken run's in the same
-    // world (before the blank both runs are the same computation).
-    let offsets = blackout::world_offsets(&lost, &clean, recovered);
     assert!(
-        offsets.len() > COMPARED_FRAMES,
+        recovery.offsets.len() > COMPARED_FRAMES,
         "{} frames compared",
-        offsets.len()
+        recovery.offsets.len()
     );
-    let median = offsets[offsets.len() / 2];
+    let median = recovery.median_offset_m();
     eprintln!("recovered at frame {recovered}; world offset median {median:.4} m");
     assert!(
         median <= 0.03,

@@ -3,8 +3,8 @@
 
 use glam::DVec3;
 use sylva_tests::{blackout, project_data_dir};
+use sylva_tracking::TrackerConfig;
 use sylva_tracking::report::run_sequence;
-use sylva_tracking::{FrameOutput, TrackerConfig};
 
 const PATH_LENGTH_M: f64 = 4.26;
 
@@ -40,27 +40,25 @@ const BLANK: std::ops::Range<usize> = 100..130;
 /// Frames allowed after the blank before tracking must be back.
 const RECOVERY_FRAMES: usize = 15;
 
-/// Tracks demo_garden frame by frame, blanking the frames in `blank`.
-fn track_blanking(blank: std::ops::Range<usize>) -> Vec<FrameOutput> {
-    blackout::track_blanking(&project_data_dir().join("demo_garden"), blank, usize::MAX)
-}
-
 #[test]
 fn after_a_forced_one_second_loss_tracking_recovers_into_the_same_world_within_2_cm() {
-    let clean = track_blanking(0..0);
-    let lost = track_blanking(BLANK);
-    let recovered =
-        blackout::recovery_frame(&lost, BLANK).expect("tracking never came back after the blank");
+    // The world after recovery is the world the tracker had before the loss (it relocalised in
+    // its map rather than starting a new one): camera positions in it match, frame by frame,
+    // those of the same tracker on the unbroken footage.
+    let recovery =
+        blackout::blank_and_recover(&project_data_dir().join("demo_garden"), BLANK, usize::MAX)
+            .expect("tracking never came back after the blank");
+    let recovered = recovery.frame;
     assert!(
         recovered < BLANK.end + RECOVERY_FRAMES,
         "tracking came back only at frame {recovered}"
     );
-    // The world after recovery is the world the tracker had before the loss (it relocalised in
-    // its map rather than starting a new one): camera positions in it match, frame by frame,
-    // those of the same tracker on the unbroken footage.
-    let offsets = blackout::world_offsets(&lost, &clean, recovered);
-    assert!(offsets.len() > 60, "{} frames compared", offsets.len());
-    let median = offsets[offsets.len() / 2];
+    assert!(
+        recovery.offsets.len() > 60,
+        "{} frames compared",
+        recovery.offsets.len()
+    );
+    let median = recovery.median_offset_m();
     eprintln!("recovered at frame {recovered}; world offset median {median:.4} m");
     assert!(
         median <= 0.02,
