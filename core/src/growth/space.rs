@@ -143,8 +143,8 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
     std::mem::swap(&mut scratch.sorted_start, &mut scratch.competing_start);
     std::mem::swap(&mut scratch.sorted_buds, &mut scratch.competing_buds);
     scratch.bud_grid.number_entries_by_slot();
-    // Each surviving point's winner (bud, distance²), found in the point grid's cell order, then
-    // summed in point order (the order of the sums fixes their rounding).
+    // Each surviving point's winner (bud, unit vector from it to the point), found in the point
+    // grid's cell order, then summed in point order (the order of the sums fixes their rounding).
     let (starts, competing) = (&scratch.competing_start, &scratch.competing_buds);
     clear_with_room(&mut scratch.point_winner, points.len());
     scratch.point_winner.resize(points.len(), NO_WINNER);
