@@ -16,7 +16,7 @@ pub use candidates::Candidates;
 pub use grid::SpatialGrid;
 pub(crate) use grid::clear_with_room;
 pub use scene::{BoxScene, HalfSpace, Scene, SceneMode, SphereScene};
-pub use shadow::ShadowGrid;
+pub use shadow::{MAX_SHADOW_DEPTH_VOXELS, MAX_VOXEL_COORD, ShadowGrid};
 
 use serde::{Deserialize, Serialize};
 

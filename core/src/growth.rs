@@ -134,6 +134,14 @@ pub(crate) struct Scratch {
     pub expired_at: Option<u32>,
 }
 
+/// No part of a tree lies further than this from its base (metres): beyond any real tree, a
+/// file that says otherwise is damaged.
+pub const MAX_TREE_EXTENT_M: f32 = 1000.0;
+
+/// Growth iterations a tree may have done (a thousand years at the shortest season a species
+/// may have): more means a damaged file.
+pub const MAX_ITERATIONS: u32 = 100_000;
+
 /// No node, in [`Scratch`]'s compact links.
 pub(crate) const NO_NODE: u32 = u32::MAX;
 
@@ -358,6 +366,15 @@ impl Tree {
     /// Arena invariants plus the growth state's own (finite values, mask in range).
     pub fn sanity_check(&self) -> Result<(), TreeInvariantError> {
         self.skeleton.sanity_check()?;
+        if self.iteration > MAX_ITERATIONS {
+            return Err(TreeInvariantError::Broken {
+                index: 0,
+                what: format!(
+                    "the tree is at iteration {} (at most {MAX_ITERATIONS})",
+                    self.iteration
+                ),
+            });
+        }
         if let Some(m) = self.growth_mask
             && m.index() >= self.skeleton.len()
         {
@@ -366,12 +383,41 @@ impl Tree {
                 what: "growth mask points past the arena".into(),
             });
         }
+        let base = self
+            .skeleton
+            .internodes
+            .first()
+            .map_or(Vec3::ZERO, |n| n.start);
         for (index, node) in self.skeleton.internodes.iter().enumerate() {
-            let buds = node.terminal_bud.iter().chain(&node.lateral_buds);
-            if buds.clone().any(|b| !b.direction.is_finite()) || !node.light_exposure.is_finite() {
+            let reach = node.start.distance(base).max(node.end.distance(base));
+            if reach > MAX_TREE_EXTENT_M {
                 return Err(TreeInvariantError::Broken {
                     index,
-                    what: "non-finite bud".into(),
+                    what: format!("lies {reach} m from the base (at most {MAX_TREE_EXTENT_M} m)"),
+                });
+            }
+            let buds = node.terminal_bud.iter().chain(&node.lateral_buds);
+            let unit = |v: Vec3| v.is_finite() && (v.length() - 1.0).abs() <= 1e-3;
+            let bad_bud =
+                |b: &Bud| !unit(b.direction) || b.tropism_override.is_some_and(|t| !unit(t));
+            if buds.clone().any(bad_bud) || !node.light_exposure.is_finite() {
+                return Err(TreeInvariantError::Broken {
+                    index,
+                    what: "a bud direction or tropism that is not a unit vector, or a non-finite light exposure".into(),
+                });
+            }
+            if !unit(node.left) {
+                return Err(TreeInvariantError::Broken {
+                    index,
+                    what: format!("L axis {} is not a unit vector", node.left),
+                });
+            }
+            if let Some(d) = node.width_constraint
+                && !(d.is_finite() && d > 0.0)
+            {
+                return Err(TreeInvariantError::Broken {
+                    index,
+                    what: format!("width constraint {d} is not a positive diameter"),
                 });
             }
             if node.born_iteration > self.iteration {

@@ -9,6 +9,8 @@ use std::path::Path;
 
 use serde::{Deserialize, Serialize};
 
+use crate::environment::MAX_SHADOW_DEPTH_VOXELS;
+
 /// Arrangement of lateral buds along an axis.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "snake_case")]
@@ -160,6 +162,9 @@ const PRESET_FILES: [(&str, &str); 6] = [
     ),
 ];
 
+/// The smallest internode and shadow voxel a species may have, metres.
+pub const MIN_VOXEL_M: f32 = 0.005;
+
 impl Species {
     /// All built-in presets, in a fixed order.
     pub fn presets() -> Vec<Species> {
@@ -214,36 +219,72 @@ impl Species {
 
     /// Checks ranges; the message names the offending parameter.
     pub fn validate(&self) -> Result<(), String> {
+        // Positive values, each inside bounds far beyond any tree (a file outside them is
+        // damaged: a micron voxel or a million-year season would stall growth); the least
+        // positive f32 stands for "more than 0".
+        let tiny = f32::MIN_POSITIVE;
         let positive = [
-            ("years_per_iteration", self.years_per_iteration),
-            ("internode_length_m", self.internode_length_m),
-            ("max_shoot_internodes", self.max_shoot_internodes),
+            ("years_per_iteration", self.years_per_iteration, 0.01, 100.0),
+            (
+                "internode_length_m",
+                self.internode_length_m,
+                MIN_VOXEL_M,
+                10.0,
+            ),
+            (
+                "max_shoot_internodes",
+                self.max_shoot_internodes,
+                tiny,
+                200.0,
+            ),
             (
                 "occupancy_radius_internodes",
                 self.occupancy_radius_internodes,
+                tiny,
+                100.0,
             ),
             (
                 "perception_distance_internodes",
                 self.perception_distance_internodes,
+                tiny,
+                100.0,
             ),
-            ("shadow_voxel_internodes", self.shadow_voxel_internodes),
-            ("shadow_strength", self.shadow_strength),
-            ("full_exposure", self.full_exposure),
-            ("tip_diameter_m", self.tip_diameter_m),
-            ("pipe_exponent", self.pipe_exponent),
+            (
+                "shadow_voxel_internodes",
+                self.shadow_voxel_internodes,
+                tiny,
+                100.0,
+            ),
+            ("shadow_strength", self.shadow_strength, tiny, 1e3),
+            ("full_exposure", self.full_exposure, tiny, 1e3),
+            ("tip_diameter_m", self.tip_diameter_m, 1e-4, 1.0),
+            ("pipe_exponent", self.pipe_exponent, 1.0, 10.0),
             (
                 "gravimorphism.vertical_semi_axis",
                 self.gravimorphism.vertical_semi_axis,
+                tiny,
+                100.0,
             ),
             (
                 "gravimorphism.parallel_semi_axis",
                 self.gravimorphism.parallel_semi_axis,
+                tiny,
+                100.0,
             ),
         ];
-        for (name, v) in positive {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(format!("{name} must be a positive number, got {v}"));
+        for (name, v, lo, hi) in positive {
+            if !(v.is_finite() && (lo..=hi).contains(&v)) {
+                return Err(format!(
+                    "{name} must be a positive number from {lo} to {hi}, got {v}"
+                ));
             }
+        }
+        let voxel = self.internode_length_m * self.shadow_voxel_internodes;
+        if voxel < MIN_VOXEL_M {
+            return Err(format!(
+                "internode_length_m × shadow_voxel_internodes (the shadow voxel) must be at \
+                 least {MIN_VOXEL_M} m, got {voxel}"
+            ));
         }
         let ranges = [
             (
@@ -303,9 +344,9 @@ impl Species {
                 "straightness α + tropism_weight β + environment_weight γ must be 1, got {sum}"
             ));
         }
-        if self.shadow_depth_voxels > 64 {
+        if self.shadow_depth_voxels > MAX_SHADOW_DEPTH_VOXELS {
             return Err(format!(
-                "shadow_depth_voxels must be at most 64, got {}",
+                "shadow_depth_voxels must be at most {MAX_SHADOW_DEPTH_VOXELS}, got {}",
                 self.shadow_depth_voxels
             ));
         }

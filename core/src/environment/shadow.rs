@@ -23,6 +23,14 @@ const UNITS_PER_SHADOW: f32 = 65_536.0;
 const BRICK_SHIFT: i32 = 3;
 const BRICK: i32 = 1 << BRICK_SHIFT;
 const BRICK_VOXELS: usize = (BRICK * BRICK * BRICK) as usize;
+/// Nodes whose voxel lies further than this from the origin along some axis (the tree's base;
+/// 41 m at the smallest voxels of the presets' benchmark tree, 133 m at a 13 cm internode) cast
+/// no shade: no tree reaches that far, and the bound keeps the brick index to at most
+/// (2·1024/8 + 2)³ cells whatever a damaged file holds.
+pub const MAX_VOXEL_COORD: i32 = 1024;
+/// The deepest pyramid a grid casts (q_max; a species' `shadow_depth_voxels` may not ask for
+/// more).
+pub const MAX_SHADOW_DEPTH_VOXELS: u32 = 64;
 /// Marks a brick-index cell that has no brick yet.
 const NO_BRICK: u32 = u32::MAX;
 /// Distance in voxels from `v` to brick `b`'s voxels along one axis (0 inside it).
@@ -80,9 +88,10 @@ pub struct ShadowGrid {
 }
 
 impl ShadowGrid {
-    /// An empty grid: voxels of `voxel_size` metres, shadow a·b^(−q) for q = 0..=q_max.
+    /// An empty grid: voxels of `voxel_size` metres, shadow a·b^(−q) for q = 0..=q_max (at most
+    /// [`MAX_SHADOW_DEPTH_VOXELS`]).
     pub fn new(voxel_size: f32, a: f32, b: f32, q_max: u32) -> Self {
-        let level_units = (0..=q_max)
+        let level_units = (0..=q_max.min(MAX_SHADOW_DEPTH_VOXELS))
             .map(|q| (a * b.powi(-(q as i32)) * UNITS_PER_SHADOW).round() as i32)
             .collect();
         ShadowGrid {
@@ -144,7 +153,8 @@ impl ShadowGrid {
         value as f32 / UNITS_PER_SHADOW
     }
 
-    /// Adds (`sign` = 1) or removes (`sign` = −1) the shadow pyramid of a node.
+    /// Adds (`sign` = 1) or removes (`sign` = −1) the shadow pyramid of a node (none for a node
+    /// beyond [`MAX_VOXEL_COORD`]).
     ///
     /// Brick by brick: each brick the pyramid reaches is looked up once, then the levels q that
     /// lie in it add Δs, masked to their square's columns, on the row where the square starts in
@@ -156,6 +166,11 @@ impl ShadowGrid {
         }
         let q_max = (self.level_units.len() - 1) as i32;
         let top = self.voxel_of(node_in_world);
+        if top.cmplt(IVec3::splat(-MAX_VOXEL_COORD)).any()
+            || top.cmpgt(IVec3::splat(MAX_VOXEL_COORD)).any()
+        {
+            return;
+        }
         let lo = top - IVec3::splat(q_max);
         let hi = top + IVec3::new(q_max, 0, q_max);
         self.ensure_index_covers(lo >> BRICK_SHIFT, hi >> BRICK_SHIFT);
@@ -258,6 +273,10 @@ impl ShadowGrid {
                 IVec3::select(hi.cmpgt(cur_hi), hi + slack, cur_hi),
             )
         };
+        // Never beyond the bricks that nodes within MAX_VOXEL_COORD can shade.
+        let limit = IVec3::splat((MAX_VOXEL_COORD + MAX_SHADOW_DEPTH_VOXELS as i32) >> BRICK_SHIFT)
+            + IVec3::ONE;
+        let (new_lo, new_hi) = (new_lo.max(-limit).min(lo), new_hi.min(limit).max(hi));
         let new_dims = new_hi - new_lo + IVec3::ONE;
         let mut brick_of = vec![NO_BRICK; (new_dims.x * new_dims.y * new_dims.z) as usize];
         for z in 0..self.brick_dims.z {

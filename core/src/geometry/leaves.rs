@@ -141,6 +141,10 @@ impl Spiral {
     }
 }
 
+/// Leaves on one internode at most (an absurdly long internode of a damaged file must not ask
+/// for billions).
+const MAX_LEAVES_PER_INTERNODE: u32 = 4096;
+
 /// [`build_leaves`] into `mesh` (cleared first, capacity reused), with `scratch` as working
 /// memory.
 pub(crate) fn build_leaves_into(
@@ -164,7 +168,7 @@ pub(crate) fn build_leaves_into(
         }
         let expected = params.leaves_per_metre * node.length;
         let jitter = hash_unit(seed ^ ((index as u64) << 20));
-        let count = (expected + jitter) as u32;
+        let count = ((expected + jitter) as u32).min(MAX_LEAVES_PER_INTERNODE);
         if count == 0 {
             continue;
         }
