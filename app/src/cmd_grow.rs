@@ -63,10 +63,16 @@ fn load_species(name_or_file: &str) -> anyhow::Result<Species> {
     }
 }
 
+/// The longest growth `sylva grow` runs (older than the oldest oaks).
+const MAX_YEARS: f32 = 1000.0;
+
 /// Grows a tree autonomously, saves it and prints a `key=value` summary line.
 pub fn grow(args: GrowArgs) -> anyhow::Result<()> {
-    if !(args.years.is_finite() && args.years >= 0.0) {
-        anyhow::bail!("--years must be a non-negative number, got {}", args.years);
+    if !(args.years.is_finite() && (0.0..=MAX_YEARS).contains(&args.years)) {
+        anyhow::bail!(
+            "--years must be a number from 0 to {MAX_YEARS}, got {}",
+            args.years
+        );
     }
     let species = load_species(&args.species)?;
     let started = Instant::now();
