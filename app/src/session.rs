@@ -17,6 +17,8 @@ use crate::state::{DesignState, InputEvent, Parameters};
 use sylva_tracking::depth_mesh::Observation;
 
 pub const SESSION_FORMAT: &str = "sylva-session";
+/// The largest side of replayed frames, pixels.
+const MAX_FRAME_SIDE: u32 = 8192;
 /// 2: frames record their tracked points (v1 sessions, made with ground-truth poses, are refused).
 pub const SESSION_VERSION: u32 = 2;
 
@@ -135,7 +137,63 @@ impl Session {
                 session.version
             );
         }
+        session
+            .check()
+            .map_err(|why| anyhow::anyhow!("{} is a damaged session: {why}", path.display()))?;
         Ok(session)
+    }
+
+    /// Why this session cannot be replayed, if it cannot: parameters, frame size, poses, tracked
+    /// points and events must all be values the app could have recorded.
+    pub fn check(&self) -> Result<(), String> {
+        self.parameters
+            .check()
+            .map_err(|why| format!("parameters: {why}"))?;
+        if !self
+            .frame_size
+            .iter()
+            .all(|&n| (1..=MAX_FRAME_SIDE).contains(&n))
+        {
+            return Err(format!(
+                "frame size {:?} (each side 1 to {MAX_FRAME_SIDE} pixels)",
+                self.frame_size
+            ));
+        }
+        for (i, frame) in self.frames.iter().enumerate() {
+            let pose = frame.world_from_camera.iter().flatten();
+            let ground = frame.ground.iter().flatten();
+            let points = frame.points.iter().flat_map(|p| [p.1, p.2, p.3]);
+            if !pose
+                .chain(ground)
+                .copied()
+                .chain(points)
+                .all(f32::is_finite)
+                || !frame.time_s.is_finite()
+            {
+                return Err(format!(
+                    "frame {i}: a non-finite pose, ground, point or time"
+                ));
+            }
+        }
+        for (i, timed) in self.events.iter().enumerate() {
+            let why = match &timed.event {
+                InputEvent::Parameters { parameters } => parameters.check().err(),
+                InputEvent::Grow { iterations }
+                    if iterations.unsigned_abs() > sylva_core::growth::MAX_ITERATIONS =>
+                {
+                    Some(format!("grows {iterations} iterations at once"))
+                }
+                InputEvent::Touch { x, y, .. } if !(x.is_finite() && y.is_finite()) => {
+                    Some(format!("touch at ({x}, {y})"))
+                }
+                _ if !timed.time_s.is_finite() => Some("a non-finite time".into()),
+                _ => None,
+            };
+            if let Some(why) = why {
+                return Err(format!("event {i}: {why}"));
+            }
+        }
+        Ok(())
     }
 
     pub fn save(&self, path: &Path) -> anyhow::Result<()> {

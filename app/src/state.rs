@@ -57,6 +57,9 @@ impl Default for Parameters {
     }
 }
 
+/// The oldest a design may be grown (the years slider offers far less).
+pub const MAX_DESIGN_YEARS: f32 = 1000.0;
+
 /// The species a new design starts with.
 pub const DEFAULT_SPECIES: &str = "maple";
 
@@ -86,6 +89,36 @@ impl Parameters {
             brush_radius: 0.12,
             grow_speed: 10.0,
         }
+    }
+
+    /// Why these parameters cannot drive a design, if they cannot (a damaged session): an
+    /// unknown species, growth values the species model refuses, or a years, brush or speed
+    /// value outside what the controls offer many times over.
+    pub fn check(&self) -> Result<(), String> {
+        let mut species = Species::by_name(&self.species)
+            .map_err(|_| format!("unknown species {:?}", self.species))?;
+        self.apply_to(&mut species);
+        species.validate()?;
+        let within = |v: f32, lo: f32, hi: f32| v.is_finite() && (lo..=hi).contains(&v);
+        if !within(self.years, 0.0, MAX_DESIGN_YEARS) {
+            return Err(format!(
+                "years must be from 0 to {MAX_DESIGN_YEARS}, got {}",
+                self.years
+            ));
+        }
+        if !within(self.brush_radius, 1e-3, 10.0) {
+            return Err(format!(
+                "brush radius must be from 0.001 to 10 m, got {}",
+                self.brush_radius
+            ));
+        }
+        if !within(self.grow_speed, -1e3, 1e3) {
+            return Err(format!(
+                "grow speed must be from -1000 to 1000 iterations/s, got {}",
+                self.grow_speed
+            ));
+        }
+        Ok(())
     }
 
     /// Writes the growth parameters into `species` (α, β, γ are the straightness, environment
@@ -342,7 +375,8 @@ impl DesignState {
 
     /// New parameters (undoable). Another species starts a seedling of it.
     fn set_parameters(&mut self, parameters: &Parameters) {
-        if *parameters == self.params {
+        // Controls cannot make parameters that fail the check; a damaged session can.
+        if *parameters == self.params || parameters.check().is_err() {
             return;
         }
         self.history.record(OperationKind::Parameters, &self.tree);
@@ -392,7 +426,10 @@ impl DesignState {
     /// Autonomous growth (positive) or ungrowing to an earlier kept iteration (negative).
     fn grow_whole_tree(&mut self, iterations: i32) {
         let target = if iterations >= 0 {
-            self.tree.iteration.saturating_add(iterations as u32)
+            self.tree
+                .iteration
+                .saturating_add(iterations as u32)
+                .min(sylva_core::growth::MAX_ITERATIONS)
         } else {
             self.tree
                 .iteration
