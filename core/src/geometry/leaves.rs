@@ -230,10 +230,9 @@ fn push_blades(mesh: &mut TreeMesh, petiole: &Petiole, block: &[Attachment]) {
         uvs[range.clone()].copy_from_slice(&[[0.0, 1.0], [1.0, 1.0], [0.0, 0.0], [1.0, 0.0]]);
         ambient[range].fill(light);
     };
-    let mut groups = block.chunks_exact(4);
+    let (groups, remainder) = block.as_chunks::<4>();
     let mut leaf = 0;
-    for group in &mut groups {
-        let group: &[Attachment; 4] = group.try_into().expect("chunks of 4");
+    for group in groups {
         match petiole.blades4(group) {
             Some(blades) => {
                 for (slot, blade) in group.iter().zip(&blades) {
@@ -249,7 +248,7 @@ fn push_blades(mesh: &mut TreeMesh, petiole: &Petiole, block: &[Attachment]) {
             }
         }
     }
-    for slot in groups.remainder() {
+    for slot in remainder {
         write(leaf, &petiole.blade(slot), slot.light);
         leaf += 1;
     }
