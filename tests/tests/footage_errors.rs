@@ -82,6 +82,18 @@ fn a_bad_camera_file_is_an_error_naming_it() {
         text.contains("camera.txt") && text.contains("line 3"),
         "{text}"
     );
+    // A size no camera has (it would size the per-frame grids) is refused too.
+    fs::write(
+        dir.path().join("camera.txt"),
+        "width 1000000000\nheight 480\nfx 500\nfy 500\ncx 320\ncy 240\n",
+    )
+    .expect("write");
+    let err = TumSequence::open(dir.path()).expect_err("absurd camera.txt");
+    let text = err.to_string();
+    assert!(
+        text.contains("camera.txt") && text.contains("1000000000"),
+        "{text}"
+    );
 }
 
 #[test]

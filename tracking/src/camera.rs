@@ -27,6 +27,9 @@ pub enum CameraError {
 }
 
 /// Intrinsics of a pinhole camera with radial-tangential distortion.
+/// The longest image side a camera file may give, pixels (beyond any phone or video camera).
+pub const MAX_IMAGE_SIDE: u32 = 16384;
+
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Camera {
     pub width: u32,
@@ -117,9 +120,15 @@ impl Camera {
             problem,
         };
         let (width, height) = (required("width")?, required("height")?);
-        if width < 1.0 || height < 1.0 || width.fract() != 0.0 || height.fract() != 0.0 {
+        let side = 1.0..=MAX_IMAGE_SIDE as f64;
+        if !side.contains(&width)
+            || !side.contains(&height)
+            || width.fract() != 0.0
+            || height.fract() != 0.0
+        {
             return Err(invalid(format!(
-                "image size {width} x {height} is not a positive whole size"
+                "image size {width} x {height} is not a whole size of 1 to {MAX_IMAGE_SIDE} \
+                 pixels a side"
             )));
         }
         let (fx, fy) = (required("fx")?, required("fy")?);
