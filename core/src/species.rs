@@ -163,7 +163,7 @@ const PRESET_FILES: [(&str, &str); 6] = [
 ];
 
 /// The smallest internode and shadow voxel a species may have, metres.
-pub const MIN_VOXEL_M: f32 = 0.005;
+pub const MIN_VOXEL_M: f32 = 0.02;
 
 impl Species {
     /// All built-in presets, in a fixed order.

@@ -23,10 +23,11 @@ const UNITS_PER_SHADOW: f32 = 65_536.0;
 const BRICK_SHIFT: i32 = 3;
 const BRICK: i32 = 1 << BRICK_SHIFT;
 const BRICK_VOXELS: usize = (BRICK * BRICK * BRICK) as usize;
-/// Nodes whose voxel lies further than this from the origin along some axis (the tree's base;
-/// 41 m at the smallest voxels of the presets' benchmark tree, 133 m at a 13 cm internode) cast
-/// no shade: no tree reaches that far, and the bound keeps the brick index to at most
-/// (2·1024/8 + 2)³ cells whatever a damaged file holds.
+/// Nodes whose voxel lies further than this from the origin along some axis (the tree's base)
+/// cast no shade: 20 m at the smallest voxel a species may have (2 cm), 41 m at the growth
+/// benchmark's 4 cm, 133 m at the presets' 13 cm; no tree reaches that far in its own voxels,
+/// and the bound keeps the brick index to at most about 270³ cells whatever a damaged file
+/// holds.
 pub const MAX_VOXEL_COORD: i32 = 1024;
 /// The deepest pyramid a grid casts (q_max; a species' `shadow_depth_voxels` may not ask for
 /// more).
