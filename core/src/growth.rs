@@ -1,13 +1,13 @@
 //! Self-organizing growth (Pałubicki et al. 2009; Longay 2014 ch. 4), one iteration (one season)
 //! at a time, step by step in the thesis' order:
 //!
-//! 1. light: bud exposure L = max(C − s + a, 0) from the shadow grid ([`light`]);
-//! 2. competition for space: attraction points, occupancy spheres, perception cones ([`space`]);
-//! 3. bud input Q = b·L^κ with gravimorphism b ([`light`]);
-//! 4. vigor: extended Borchert–Honda, basipetal then acropetal ([`vigor`]);
-//! 5. and 6. shoots of n = ⌊v/v_max·n_max⌋ internodes heading H' = αH + βT + γE ([`shoots`]);
-//! 7. shedding of branches whose vigor per internode falls below Th ([`vigor`]);
-//! 8. widths by the pipe model, exponents re-solved below width constraints ([`widths`]).
+//! 1. light: bud exposure L = max(C − s + a, 0) from the shadow grid (module `light`);
+//! 2. competition for space: attraction points, occupancy spheres, perception cones (module `space`);
+//! 3. bud input Q = b·L^κ with gravimorphism b (module `light`);
+//! 4. vigor: extended Borchert–Honda, basipetal then acropetal (module `vigor`);
+//! 5. and 6. shoots of n = ⌊v/v_max·n_max⌋ internodes heading H' = αH + βT + γE (module `shoots`);
+//! 7. shedding of branches whose vigor per internode falls below Th (module `vigor`);
+//! 8. widths by the pipe model, exponents re-solved below width constraints (module `widths`).
 //!
 //! Space: world metres, Y up, base at the origin. All randomness comes from `Tree::rng`, so the
 //! same species, seed and calls give a byte-identical saved tree.
@@ -342,7 +342,7 @@ impl Tree {
         (exposure / s.full_exposure).clamp(0.0, 1.0)
     }
 
-    /// Recomputes every diameter by the pipe model (see [`widths`]); call after edits.
+    /// Recomputes every diameter by the pipe model (module `widths`); call after edits.
     pub fn update_widths(&mut self) {
         let mut scratch = std::mem::take(&mut self.scratch);
         widths::update(

@@ -4,7 +4,7 @@
 //! adjacent prisms meet at a joint face, a bilinear patch spanned by the U and L axes of the
 //! HLU frame. Bending moves each prism i by a rigid transform (Rᵢ, tᵢ) so as to minimise
 //!
-//! E = Σ_joints w_ij E_ij,   E_ij = ∫∫_{[0,1]²} ‖f^{i→j}(u,v) − f^{j→i}(u,v)‖² du dv   (A.1)
+//! E = Σ_joints w_ij E_ij,   E_ij = ∫∫_{\[0,1\]²} ‖f^{i→j}(u,v) − f^{j→i}(u,v)‖² du dv   (A.1)
 //!
 //! with the flexural stiffness wᵢ = rᵢ⁴ / lᵢ (A.3) (joint weight: the two half-prisms in series,
 //! the harmonic mean of wᵢ and wⱼ) under positional constraints on the end points of E and of any
@@ -12,7 +12,7 @@
 //!
 //! Solver: faces are integrated exactly with 2×2 Gauss points (the integrand is bi-quadratic).
 //! A global Levenberg–Marquardt solve over all prisms (block-tridiagonal normal equations, see
-//! [`super::bend_solver`]) is followed by iterated local shape matching (A.2): each prism takes
+//! module `bend_solver`) is followed by iterated local shape matching (A.2): each prism takes
 //! Horn's closed-form best rigid motion onto its neighbours' faces. Local matching alone moves
 //! information one prism per sweep and does not settle long paths interactively, hence the
 //! global step. Every solve starts from the rest pose, so the result depends only on the
@@ -165,7 +165,7 @@ impl Bend {
     }
 
     /// Solves for the pose that satisfies `constraints`, always starting from the rest pose:
-    /// Levenberg–Marquardt over the whole path (see [`bend_solver`]), then local shape-matching
+    /// Levenberg–Marquardt over the whole path (module `bend_solver`), then local shape-matching
     /// sweeps (Horn) that polish each prism against its neighbours' faces.
     pub fn solve(&self, constraints: &[PositionalConstraint]) -> Result<BendPose, EditError> {
         let pins = self.pins(constraints)?;

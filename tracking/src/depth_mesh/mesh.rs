@@ -376,8 +376,8 @@ impl DepthMesh {
 
     /// Checks the invariants (spade keeps its own checks test-only, so these are ours): every
     /// id maps to the vertex holding it, the surface is a subset of all points at the same
-    /// positions, and both layers are Delaunay triangulations (see
-    /// [`super::validity::check_triangulation`]).
+    /// positions, and both layers are Delaunay triangulations (checked by
+    /// `validity::check_triangulation`).
     pub fn sanity_check(&self) {
         for layer in [&self.all, &self.surface] {
             assert_eq!(
