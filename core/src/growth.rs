@@ -138,6 +138,9 @@ pub(crate) struct Scratch {
 /// file that says otherwise is damaged.
 pub const MAX_TREE_EXTENT_M: f32 = 1000.0;
 
+/// The widest diameter a width constraint may ask for, metres (wider than any trunk).
+pub const MAX_WIDTH_CONSTRAINT_M: f32 = 10.0;
+
 /// Growth iterations a tree may have done (a thousand years at the shortest season a species
 /// may have): more means a damaged file.
 pub const MAX_ITERATIONS: u32 = 100_000;
@@ -413,11 +416,13 @@ impl Tree {
                 });
             }
             if let Some(d) = node.width_constraint
-                && !(d.is_finite() && d > 0.0)
+                && !(d.is_finite() && d > 0.0 && d <= MAX_WIDTH_CONSTRAINT_M)
             {
                 return Err(TreeInvariantError::Broken {
                     index,
-                    what: format!("width constraint {d} is not a positive diameter"),
+                    what: format!(
+                        "width constraint {d} is not a diameter in (0, {MAX_WIDTH_CONSTRAINT_M}] m"
+                    ),
                 });
             }
             if node.born_iteration > self.iteration {

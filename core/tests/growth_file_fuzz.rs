@@ -25,7 +25,7 @@ const BAD_VALUES: [&str; 8] = [
 /// A small tree that uses every kind of field: width constraint, bud tropism, brush points.
 fn sample_tree() -> Tree {
     let mut tree = Tree::new(Species::by_name("birch").expect("birch preset"), 3);
-    tree.grow(3, None);
+    tree.grow(2, None);
     let tip = tree.skeleton.len() - 1;
     tree.skeleton.internodes[tip / 2].width_constraint = Some(0.02);
     if let Some(bud) = tree.skeleton.internodes[tip].terminal_bud.as_mut() {
