@@ -1,0 +1,69 @@
+//! Tries a species preset with some of its values replaced, on three seeds: height, spread and
+//! internodes at 10, 15 and 30 years against the preset's stated figures, and the worst
+//! deviation. The tool the presets were refitted with.
+//!
+//! `cargo run --release -p sylva-core --example preset_fit -- birch apical_dominance=0.56 ...`
+//! (values as JSON: numbers, `true`, `"spiral"`).
+
+use sylva_core::Tree;
+use sylva_core::species::Species;
+
+/// Seeds tried: the suite's, the README pictures', the benchmark's.
+const SEEDS: [u64; 3] = [2014, 11, 7];
+
+fn main() {
+    let args: Vec<String> = std::env::args().skip(1).collect();
+    let Some(name) = args.first() else {
+        eprintln!("usage: preset_fit PRESET [field=json ...]");
+        std::process::exit(2);
+    };
+    let preset = Species::by_name(name).unwrap_or_else(|e| panic!("{e}"));
+    let mut fields = serde_json::to_value(&preset).expect("a species serializes");
+    for pair in &args[1..] {
+        let (key, value) = pair
+            .split_once('=')
+            .unwrap_or_else(|| panic!("{pair}: expected field=value"));
+        fields[key] = serde_json::from_str(value).unwrap_or_else(|e| panic!("{pair}: {e}"));
+    }
+    let species: Species = serde_json::from_value(fields).unwrap_or_else(|e| panic!("{e}"));
+    if let Err(why) = species.validate() {
+        eprintln!("not a valid species: {why}");
+        std::process::exit(1);
+    }
+    let e = species.expected.clone();
+    let mut worst = 0.0f32;
+    for seed in SEEDS {
+        let mut tree = Tree::new(species.clone(), seed);
+        tree.grow_years(10.0);
+        let at10 = tree.metrics();
+        tree.grow_years(5.0);
+        let at15 = tree.metrics();
+        tree.grow_years(15.0);
+        let at30 = tree.metrics();
+        println!(
+            "seed {seed:5}: 10y h {:5.2}/{:5.2} w {:5.2}/{:5.2} n {:6} | 15y n {:6} | \
+             30y h {:5.2}/{:5.2} w {:5.2}/{:5.2} n {:6} trunk {:.3} m",
+            at10.height_m,
+            e.height_10y_m,
+            at10.crown_width_m,
+            e.spread_10y_m,
+            at10.num_internodes,
+            at15.num_internodes,
+            at30.height_m,
+            e.height_30y_m,
+            at30.crown_width_m,
+            e.spread_30y_m,
+            at30.num_internodes,
+            at30.trunk_diameter_m
+        );
+        for (measured, expected) in [
+            (at10.height_m, e.height_10y_m),
+            (at10.crown_width_m, e.spread_10y_m),
+            (at30.height_m, e.height_30y_m),
+            (at30.crown_width_m, e.spread_30y_m),
+        ] {
+            worst = worst.max((measured / expected - 1.0).abs());
+        }
+    }
+    println!("worst deviation {:.0}%", worst * 100.0);
+}
