@@ -3,7 +3,7 @@
 //! deviation. The tool the presets were refitted with.
 //!
 //! `cargo run --release -p sylva-core --example preset_fit -- birch apical_dominance=0.56 ...`
-//! (values as JSON: numbers, `true`, `"spiral"`).
+//! (values as JSON: numbers, `true`, `"spiral"`). `SYLVA_SEEDS=1,2,3` tries other seeds.
 
 use sylva_core::Tree;
 use sylva_core::species::Species;
@@ -31,8 +31,17 @@ fn main() {
         std::process::exit(1);
     }
     let e = species.expected.clone();
+    let seeds: Vec<u64> = std::env::var("SYLVA_SEEDS").map_or(SEEDS.to_vec(), |list| {
+        list.split(',')
+            .map(|s| {
+                s.trim()
+                    .parse()
+                    .unwrap_or_else(|e| panic!("SYLVA_SEEDS {s}: {e}"))
+            })
+            .collect()
+    });
     let mut worst = 0.0f32;
-    for seed in SEEDS {
+    for seed in seeds {
         let mut tree = Tree::new(species.clone(), seed);
         tree.grow_years(10.0);
         let at10 = tree.metrics();
