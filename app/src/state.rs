@@ -29,7 +29,7 @@ pub struct Parameters {
     pub apical_dominance: f32,   /* λ */
     pub light_sensitivity: f32,  /* κ */
     pub shedding_threshold: f32, /* Th */
-    pub max_shoot_length: u32,   /* n_max */
+    pub max_shoot_length: f32,   /* n_max */
     /// Shoot direction blend: α default (heading), β environment (brush), γ tropism; sums to 1.
     pub direction_weights: [f32; 3], /* α β γ */
     /// Tropism direction angle from vertical, radians.
@@ -71,7 +71,7 @@ impl Parameters {
             apical_dominance: species.apical_dominance,
             light_sensitivity: species.light_sensitivity,
             shedding_threshold: species.shedding_threshold,
-            max_shoot_length: species.max_shoot_internodes.round().max(1.0) as u32,
+            max_shoot_length: species.max_shoot_internodes,
             direction_weights: normalised_weights([
                 species.straightness,
                 species.environment_weight,
@@ -127,7 +127,7 @@ impl Parameters {
         species.apical_dominance = self.apical_dominance;
         species.light_sensitivity = self.light_sensitivity;
         species.shedding_threshold = self.shedding_threshold;
-        species.max_shoot_internodes = self.max_shoot_length.max(1) as f32;
+        species.max_shoot_internodes = self.max_shoot_length.max(1.0);
         let [alpha, beta, gamma] = self.direction_weights;
         species.straightness = alpha;
         species.environment_weight = beta;

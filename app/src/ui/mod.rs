@@ -183,7 +183,9 @@ fn growth_ui(ui: &mut Ui, params: &mut crate::state::Parameters) {
             egui::Slider::new(&mut params.shedding_threshold, 0.0..=1.0)
                 .text("Th shedding threshold"),
         );
-        ui.add(egui::Slider::new(&mut params.max_shoot_length, 1..=10).text("n_max shoot length"));
+        ui.add(
+            egui::Slider::new(&mut params.max_shoot_length, 1.0..=20.0).text("n_max shoot length"),
+        );
     });
 }
 
