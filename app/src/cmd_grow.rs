@@ -7,6 +7,8 @@ use anyhow::Context;
 use sylva_core::Tree;
 use sylva_core::species::Species;
 
+use crate::state::MAX_DESIGN_YEARS;
+
 /// Arguments of `sylva grow`.
 #[derive(clap::Args, Debug)]
 pub struct GrowArgs {
@@ -63,14 +65,11 @@ fn load_species(name_or_file: &str) -> anyhow::Result<Species> {
     }
 }
 
-/// The longest growth `sylva grow` runs (older than the oldest oaks).
-const MAX_YEARS: f32 = 1000.0;
-
 /// Grows a tree autonomously, saves it and prints a `key=value` summary line.
 pub fn grow(args: GrowArgs) -> anyhow::Result<()> {
-    if !(args.years.is_finite() && (0.0..=MAX_YEARS).contains(&args.years)) {
+    if !(args.years.is_finite() && (0.0..=MAX_DESIGN_YEARS).contains(&args.years)) {
         anyhow::bail!(
-            "--years must be a number from 0 to {MAX_YEARS}, got {}",
+            "--years must be a number from 0 to {MAX_DESIGN_YEARS}, got {}",
             args.years
         );
     }

@@ -57,7 +57,8 @@ impl Default for Parameters {
     }
 }
 
-/// The oldest a design may be grown (the years slider offers far less).
+/// The oldest a tree may be grown, in the app or by `sylva grow` (the years slider offers far
+/// less).
 pub const MAX_DESIGN_YEARS: f32 = 1000.0;
 
 /// The species a new design starts with.

@@ -65,12 +65,7 @@ fn main() {
             at30.num_internodes,
             at30.trunk_diameter_m
         );
-        for (measured, expected) in [
-            (at10.height_m, e.height_10y_m),
-            (at10.crown_width_m, e.spread_10y_m),
-            (at30.height_m, e.height_30y_m),
-            (at30.crown_width_m, e.spread_30y_m),
-        ] {
+        for (_, measured, expected) in e.against(&at10, &at30) {
             worst = worst.max((measured / expected - 1.0).abs());
         }
     }

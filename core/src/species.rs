@@ -10,6 +10,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use crate::environment::MAX_SHADOW_DEPTH_VOXELS;
+use crate::growth::TreeMetrics;
 
 /// Arrangement of lateral buds along an axis.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
@@ -45,6 +46,38 @@ pub struct ExpectedSize {
     pub spread_30y_m: f32,
     /// The reference(s) the figures come from, by name.
     pub source: String,
+}
+
+impl ExpectedSize {
+    /// Each stated figure beside the grown tree's: (what, measured, expected), metres.
+    pub fn against(
+        &self,
+        at_10_years: &TreeMetrics,
+        at_30_years: &TreeMetrics,
+    ) -> [(&'static str, f32, f32); 4] {
+        [
+            (
+                "height at 10 years",
+                at_10_years.height_m,
+                self.height_10y_m,
+            ),
+            (
+                "spread at 10 years",
+                at_10_years.crown_width_m,
+                self.spread_10y_m,
+            ),
+            (
+                "height at 30 years",
+                at_30_years.height_m,
+                self.height_30y_m,
+            ),
+            (
+                "spread at 30 years",
+                at_30_years.crown_width_m,
+                self.spread_30y_m,
+            ),
+        ]
+    }
 }
 
 /// All parameters of one species.

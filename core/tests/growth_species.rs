@@ -35,12 +35,7 @@ fn every_preset_lands_within_30_percent_of_its_stated_height_and_spread_at_10_an
             at30.num_internodes,
             at30.trunk_diameter_m
         );
-        for (what, measured, expected) in [
-            ("height at 10 years", at10.height_m, e.height_10y_m),
-            ("spread at 10 years", at10.crown_width_m, e.spread_10y_m),
-            ("height at 30 years", at30.height_m, e.height_30y_m),
-            ("spread at 30 years", at30.crown_width_m, e.spread_30y_m),
-        ] {
+        for (what, measured, expected) in e.against(&at10, &at30) {
             if !within(measured, expected) {
                 failures.push(format!(
                     "{name}: {what} {measured:.2} m, expected {expected:.2} m ±30%"

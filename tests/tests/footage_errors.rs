@@ -71,25 +71,19 @@ fn corrupt_truncated_and_missing_frames_are_skipped_by_name_and_tracking_goes_on
 fn a_bad_camera_file_is_an_error_naming_it() {
     let dir = tempfile::tempdir().expect("temp dir");
     copy_head(dir.path(), 5);
-    fs::write(
-        dir.path().join("camera.txt"),
-        "width 640\nheight 480\nfx five hundred\n",
-    )
-    .expect("write");
-    let err = TumSequence::open(dir.path()).expect_err("bad camera.txt");
-    let text = err.to_string();
+    // The error opening the sequence with `camera` as its camera.txt.
+    let open_with = |camera: &str| {
+        fs::write(dir.path().join("camera.txt"), camera).expect("write");
+        let err = TumSequence::open(dir.path()).expect_err("bad camera.txt accepted");
+        err.to_string()
+    };
+    let text = open_with("width 640\nheight 480\nfx five hundred\n");
     assert!(
         text.contains("camera.txt") && text.contains("line 3"),
         "{text}"
     );
     // A size no camera has (it would size the per-frame grids) is refused too.
-    fs::write(
-        dir.path().join("camera.txt"),
-        "width 1000000000\nheight 480\nfx 500\nfy 500\ncx 320\ncy 240\n",
-    )
-    .expect("write");
-    let err = TumSequence::open(dir.path()).expect_err("absurd camera.txt");
-    let text = err.to_string();
+    let text = open_with("width 1000000000\nheight 480\nfx 500\nfy 500\ncx 320\ncy 240\n");
     assert!(
         text.contains("camera.txt") && text.contains("1000000000"),
         "{text}"
