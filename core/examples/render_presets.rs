@@ -1,6 +1,7 @@
 //! Renders every species preset, grown for a number of years, into `docs/images/<name>.png`
 //! with a small z-buffered CPU rasterizer: perspective camera, bark and leaf textures (leaves
-//! alpha-tested), ambient light from the growth shadow grid times a Lambert sun term.
+//! alpha-tested), ambient light from the growth shadow grid times a Lambert sun term, over a
+//! disc of lawn at the ground plane (darker where the crown shades it).
 //! Stands in for the app's offscreen renderer for the README pictures.
 //!
 //! `cargo run --release -p sylva-core --example render_presets [years] [out_dir]`
@@ -133,6 +134,51 @@ fn fill(target: &mut Target, [a, b, c]: [ScreenVertex; 3], texture: &RgbaImage, 
     }
 }
 
+/// The lawn: a disc of the ground plane (y = 0) around the base, `radius` metres wide, shaded by
+/// the growth shadow grid's ambient light (darker under the crown).
+fn draw_ground(target: &mut Target, tree: &Tree, radius: f32, clip_from_world: Mat4) {
+    const RINGS: u32 = 32;
+    const SECTORS: u32 = 128;
+    let grass = RgbaImage::from_pixel(1, 1, Rgba([104, 132, 70, 255]));
+    let vertex = |ring: u32, sector: u32| -> Option<ScreenVertex> {
+        let (sin, cos) = (sector as f32 / SECTORS as f32 * std::f32::consts::TAU).sin_cos();
+        let r = radius * ring as f32 / RINGS as f32;
+        let world = Vec3::new(r * cos, 0.0, r * sin);
+        let clip = clip_from_world * world.extend(1.0);
+        if clip.w <= 1e-4 {
+            return None;
+        }
+        let ndc = clip.xyz() / clip.w;
+        // Light a little above the ground, where the lowest leaves would be.
+        let ambient = tree.ambient_at(world + Vec3::Y * 0.1);
+        Some(ScreenVertex {
+            pixel: Vec2::new(
+                (ndc.x * 0.5 + 0.5) * WIDTH as f32,
+                (0.5 - ndc.y * 0.5) * HEIGHT as f32,
+            ),
+            depth: ndc.z,
+            uv: Vec2::ZERO,
+            shade: 0.45 + 0.55 * ambient,
+        })
+    };
+    for ring in 0..RINGS {
+        for sector in 0..SECTORS {
+            let next = (sector + 1) % SECTORS;
+            let corners = [
+                vertex(ring, sector),
+                vertex(ring + 1, sector),
+                vertex(ring + 1, next),
+                vertex(ring, next),
+            ];
+            let [Some(a), Some(b), Some(c), Some(d)] = corners else {
+                continue;
+            };
+            fill(target, [a, b, c], &grass, false);
+            fill(target, [a, c, d], &grass, false);
+        }
+    }
+}
+
 fn render(
     tree: &Tree,
     out: &std::path::Path,
@@ -156,6 +202,8 @@ fn render(
         color: RgbaImage::from_fn(WIDTH, HEIGHT, |_, y| sky(y)),
         depth: vec![f32::INFINITY; (WIDTH * HEIGHT) as usize],
     };
+    let ground_radius = 0.6 * (hi - lo).x.max((hi - lo).z).max(1.0);
+    draw_ground(&mut target, tree, ground_radius, clip_from_world);
     let lod = &meshes.lods[0];
     let bark = bark_texture(meshes.colors.bark, 128);
     let leaf = leaf_texture(meshes.colors.leaf, 128);

@@ -9,8 +9,9 @@
 //! 7. shedding of branches whose vigor per internode falls below Th (module `vigor`);
 //! 8. widths by the pipe model, exponents re-solved below width constraints (module `widths`).
 //!
-//! Space: world metres, Y up, base at the origin. All randomness comes from `Tree::rng`, so the
-//! same species, seed and calls give a byte-identical saved tree.
+//! Space: world metres, Y up, base at the origin. The ground is the plane y = 0 through the base:
+//! attraction points below it are dropped and no shoot grows into it. All randomness comes from
+//! `Tree::rng`, so the same species, seed and calls give a byte-identical saved tree.
 
 mod buds;
 mod io;
@@ -240,6 +241,11 @@ impl Tree {
     pub fn grow_years(&mut self, years: f32) -> IterationStats {
         let iterations = self.species.iterations_for_years(years);
         self.grow(iterations, None)
+    }
+
+    /// Height of the ground the tree stands on (see [`Skeleton::ground_y`]).
+    pub fn ground_y(&self) -> f32 {
+        self.skeleton.ground_y()
     }
 
     /// Age in years.

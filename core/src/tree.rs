@@ -145,6 +145,12 @@ impl Skeleton {
         self.internodes.is_empty()
     }
 
+    /// Height of the ground: the horizontal plane through the base of the trunk (0 for a tree
+    /// grown from [`crate::Tree::new`]). Growth never goes below it.
+    pub fn ground_y(&self) -> f32 {
+        self.internodes.first().map_or(0.0, |n| n.start.y)
+    }
+
     /// Flags every internode in the subtrees rooted at `roots` (a root and all its descendants).
     pub fn subtree_flags(&self, roots: &[NodeId]) -> Vec<bool> {
         let mut flags = vec![false; self.internodes.len()];

@@ -4,7 +4,9 @@
 //! New internodes are appended to the arena, so it stays in topological order; every new node
 //! casts its shadow at once and consumes the attraction points in its occupancy sphere, and each
 //! further internode of a shoot re-perceives the remaining points (so a thin brush stroke is
-//! followed internode by internode).
+//! followed internode by internode). A shoot stops where its next internode would go below the
+//! ground (the horizontal plane through the tree's base), as it stops at a scene it grows in
+//! front of.
 
 use glam::Vec3;
 
@@ -159,6 +161,7 @@ fn grow_shoot(
     let mut carried = won.tropism_sum.try_normalize();
     // What the tip perceived after the previous internode (none before the first).
     let mut perceived: Option<(Vec3, Option<Vec3>)> = None;
+    let ground_y = tree.ground_y();
     for k in 0..n {
         let tip = tree.skeleton.internodes[parent].end;
         if let Some((e, t)) = perceived.take() {
@@ -175,7 +178,8 @@ fn grow_shoot(
             .try_normalize()
             .unwrap_or(heading);
         let end = tip + new_heading * l;
-        if front.is_some_and(|scene| !scene.is_segment_free(tip, end)) {
+        // The ground and a scene grown in front of stop the shoot where it would enter them.
+        if end.y < ground_y || front.is_some_and(|scene| !scene.is_segment_free(tip, end)) {
             return k as usize;
         }
         let random_azimuth = tree.rng.range_f32(0.0, std::f32::consts::TAU);

@@ -40,6 +40,21 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
     if options.autonomous {
         generate_points(tree, scratch, r, perception, cos_half);
     }
+    // The ground: no point below the plane through the base feeds a bud (brushed points there
+    // are dropped too; generated ones never enter the set).
+    let ground_y = tree.ground_y();
+    if tree
+        .environment
+        .attraction
+        .points
+        .iter()
+        .any(|p| p.persistent && p.position.y < ground_y)
+    {
+        tree.environment
+            .attraction
+            .points
+            .retain(|p| p.position.y >= ground_y);
+    }
     if let Some(constraint) = tree.environment.depth_constraint {
         tree.environment
             .attraction
@@ -211,13 +226,15 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
     alive_count
 }
 
-/// Autonomous points: each bud adds 1 + round((max − 1)·L/C) points in its perception shell.
+/// Autonomous points: each bud adds 1 + round((max − 1)·L/C) points in its perception shell
+/// (those that fall below the ground are drawn, then dropped).
 fn generate_points(tree: &mut Tree, scratch: &Scratch, r: f32, perception: f32, cos_half: f32) {
     let s = &tree.species;
     let extra = (s.max_points_per_bud - 1) as f32;
     let (r3, p3) = (r * r * r, perception * perception * perception);
     let points: &mut AttractionPoints = &mut tree.environment.attraction;
     let rng: &mut Rng = &mut tree.rng;
+    let ground_y = tree.skeleton.ground_y();
     points.points.reserve(scratch.buds.len() * 2);
     for bud in scratch.buds.iter().filter(|b| b.competes) {
         let position = scratch.node_end[bud.node as usize];
@@ -231,7 +248,10 @@ fn generate_points(tree: &mut Tree, scratch: &Scratch, r: f32, perception: f32, 
             let (sa, ca) = rng.range_f32(0.0, std::f32::consts::TAU).sin_cos();
             let dir = cos_polar * bud.direction + sin_polar * (ca * b1 + sa * b2);
             let radius = (r3 + rng.next_f32() * (p3 - r3)).cbrt();
-            points.add_transient(position + dir * radius);
+            let point = position + dir * radius;
+            if point.y >= ground_y {
+                points.add_transient(point);
+            }
         }
     }
 }
