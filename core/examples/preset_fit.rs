@@ -42,13 +42,10 @@ fn main() {
     });
     let mut worst = 0.0f32;
     for seed in seeds {
-        let mut tree = Tree::new(species.clone(), seed);
-        tree.grow_years(10.0);
-        let at10 = tree.metrics();
-        tree.grow_years(5.0);
-        let at15 = tree.metrics();
-        tree.grow_years(15.0);
-        let at30 = tree.metrics();
+        let [at10, at15, at30] = Tree::metrics_at_ages(&species, seed, &[10.0, 15.0, 30.0])[..]
+        else {
+            unreachable!("three ages, three metrics")
+        };
         println!(
             "seed {seed:5}: 10y h {:5.2}/{:5.2} w {:5.2}/{:5.2} n {:6} | 15y n {:6} | \
              30y h {:5.2}/{:5.2} w {:5.2}/{:5.2} n {:6} trunk {:.3} m",

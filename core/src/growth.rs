@@ -243,6 +243,19 @@ impl Tree {
         self.grow(iterations, None)
     }
 
+    /// The metrics of a tree of `species` grown from `seed`, at each age of `ages_years` (in
+    /// increasing order; one tree grows through all of them).
+    pub fn metrics_at_ages(species: &Species, seed: u64, ages_years: &[f32]) -> Vec<TreeMetrics> {
+        let mut tree = Tree::new(species.clone(), seed);
+        ages_years
+            .iter()
+            .map(|&age| {
+                tree.grow_years((age - tree.age_years()).max(0.0));
+                tree.metrics()
+            })
+            .collect()
+    }
+
     /// Height of the ground the tree stands on (see [`Skeleton::ground_y`]).
     pub fn ground_y(&self) -> f32 {
         self.skeleton.ground_y()

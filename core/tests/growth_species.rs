@@ -1,14 +1,22 @@
 //! Every species preset grows to within ±30% of its stated height and crown spread at 10 and 30
-//! years, and keeps its botanical character.
+//! years (the tree of seed 2014 and the median tree of five seeds; no seed's tree beyond ±50%),
+//! and keeps its botanical character.
 
 use sylva_core::Tree;
 use sylva_core::species::Species;
 
+/// The seed of the character test and the first of the size test's seeds.
 const SEED: u64 = 2014;
+/// A young tree's spread rests on a few branches, so one seed can land anywhere in the natural
+/// spread of a species: the stated figures are held against the median of these.
+const SEEDS: [u64; 5] = [SEED, 1, 2, 3, 4];
 const TOLERANCE: f32 = 0.30;
+/// No single seed's tree may be further than this from a stated figure.
+const OUTLIER_TOLERANCE: f32 = 0.50;
 
-fn within(measured: f32, expected: f32) -> bool {
-    (measured - expected).abs() <= TOLERANCE * expected
+fn median(mut values: Vec<f32>) -> f32 {
+    values.sort_by(f32::total_cmp);
+    values[values.len() / 2]
 }
 
 #[test]
@@ -17,28 +25,47 @@ fn every_preset_lands_within_30_percent_of_its_stated_height_and_spread_at_10_an
     for species in Species::presets() {
         let e = species.expected.clone();
         let name = species.name.clone();
-        let mut tree = Tree::new(species, SEED);
-        tree.grow_years(10.0);
-        let at10 = tree.metrics();
-        tree.grow_years(20.0);
-        let at30 = tree.metrics();
-        println!(
-            "{name:16} 10y: h {:5.2}/{:5.2} w {:5.2}/{:5.2}  30y: h {:5.2}/{:5.2} w {:5.2}/{:5.2}  n={} d={:.3}",
-            at10.height_m,
-            e.height_10y_m,
-            at10.crown_width_m,
-            e.spread_10y_m,
-            at30.height_m,
-            e.height_30y_m,
-            at30.crown_width_m,
-            e.spread_30y_m,
-            at30.num_internodes,
-            at30.trunk_diameter_m
-        );
-        for (what, measured, expected) in e.against(&at10, &at30) {
-            if !within(measured, expected) {
+        // Per stated figure: (what, expected, the measurement of each seed).
+        let mut figures: Vec<(&str, f32, Vec<f32>)> = Vec::new();
+        for seed in SEEDS {
+            let [at10, at30] = Tree::metrics_at_ages(&species, seed, &[10.0, 30.0])[..] else {
+                unreachable!("two ages, two metrics")
+            };
+            let figures_line: Vec<String> = e
+                .against(&at10, &at30)
+                .iter()
+                .map(|(what, m, x)| format!("{what} {m:.2}/{x:.2}"))
+                .collect();
+            println!(
+                "{name:16} seed {seed:4}: {}; n={} d={:.3}",
+                figures_line.join(", "),
+                at30.num_internodes,
+                at30.trunk_diameter_m
+            );
+            for (k, (what, measured, expected)) in e.against(&at10, &at30).into_iter().enumerate() {
+                if k == figures.len() {
+                    figures.push((what, expected, Vec::new()));
+                }
+                figures[k].2.push(measured);
+                let deviation = (measured / expected - 1.0).abs();
+                if seed == SEED && deviation > TOLERANCE {
+                    failures.push(format!(
+                        "{name}, seed {seed}: {what} {measured:.2} m, expected {expected:.2} m ±30%"
+                    ));
+                }
+                if deviation > OUTLIER_TOLERANCE {
+                    failures.push(format!(
+                        "{name}, seed {seed}: {what} {measured:.2} m, expected {expected:.2} m ±50%"
+                    ));
+                }
+            }
+        }
+        for (what, expected, measured) in figures {
+            let m = median(measured);
+            println!("{name:16} median {what}: {m:.2} m against {expected:.2} m");
+            if (m / expected - 1.0).abs() > TOLERANCE {
                 failures.push(format!(
-                    "{name}: {what} {measured:.2} m, expected {expected:.2} m ±30%"
+                    "{name}: median {what} {m:.2} m, expected {expected:.2} m ±30%"
                 ));
             }
         }
