@@ -82,6 +82,9 @@ pub struct TreeMetrics {
     /// Diameter at the base of the trunk.
     pub trunk_diameter_m: f32,
     pub age_years: f32,
+    /// How far the tree leans: the horizontal distance from the base to the centre of the wood
+    /// (internode midpoints weighted by length), over the height (0 for an upright tree).
+    pub lean: f32,
 }
 
 /// Per-iteration working memory, kept between iterations so the hot loops do not allocate.
@@ -457,21 +460,32 @@ impl Tree {
         Ok(())
     }
 
-    /// Height, crown spread, trunk diameter and size.
+    /// Height, crown spread, trunk diameter, size and lean.
     pub fn metrics(&self) -> TreeMetrics {
         let nodes = &self.skeleton.internodes;
         let base = nodes.first().map_or(Vec3::ZERO, |n| n.start);
         let (mut lo, mut hi) = (base, base);
+        let (mut centre, mut length) = (Vec3::ZERO, 0.0);
         for n in nodes {
             lo = lo.min(n.end);
             hi = hi.max(n.end);
+            let l = n.start.distance(n.end);
+            centre += (n.start + n.end) * 0.5 * l;
+            length += l;
         }
+        let offset = centre / length.max(1e-9) - base;
+        let height = hi.y - base.y;
         TreeMetrics {
             num_internodes: nodes.len(),
             height_m: hi.y - base.y,
             crown_width_m: 0.5 * ((hi.x - lo.x) + (hi.z - lo.z)),
             trunk_diameter_m: nodes.first().map_or(0.0, |n| n.diameter),
             age_years: self.age_years(),
+            lean: if height > 0.0 {
+                offset.x.hypot(offset.z) / height
+            } else {
+                0.0
+            },
         }
     }
 }

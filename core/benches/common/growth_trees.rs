@@ -14,12 +14,19 @@ pub const SEED: u64 = 7;
 pub const STEPS_PER_RESTORE: u64 = 8;
 
 /// Maple with short internodes (4 cm), long shoots (n_max = 12) and no age slow-down: a dense
-/// crown that reaches 100k internodes in about 24 iterations.
+/// crown that reaches 100k internodes in about 25 iterations. The values the maple preset was
+/// refitted in are pinned to those the benchmark has always grown with, so the benchmark's
+/// trees do not change with the preset.
 pub fn bench_species() -> Species {
     let mut s = Species::by_name("maple").expect("maple preset");
     s.internode_length_m = 0.04;
     s.max_shoot_internodes = 12.0;
     s.shoot_length_halving_age_years = 0.0;
+    s.apical_dominance = 0.565;
+    s.straightness = 0.4;
+    s.tropism_weight = 0.1;
+    s.environment_weight = 0.5;
+    s.deflection_angle_deg = 5.0;
     s
 }
 
