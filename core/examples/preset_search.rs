@@ -22,25 +22,63 @@ const HELD_OUT_SEEDS: [u64; 6] = [101, 102, 103, 104, 105, 106];
 /// outlier bound).
 const GIVE_UP: f32 = 0.5;
 
-/// Over `seeds`: the worst deviation of a median (per stated figure, the median tree's relative
-/// deviation; the suite holds these to 30%), the worst single tree's deviation (the suite holds
-/// it to 50%), the mean internode count at 30 years and the worst lean at 15 and 30 years.
-/// `None` once a single tree passes `give_up` or leans more than `max_lean`.
-fn evaluate(
-    species: &Species,
-    seeds: &[u64],
+/// The crown's radius (from the trunk's vertical) in the slices at 70–90% of the height, over
+/// its widest slice's: near 1 for a dome or a column, small for a cone.
+fn upper_crown(tree: &Tree) -> f32 {
+    let height = tree.metrics().height_m.max(1e-6);
+    let mut radius = [0.0f32; 10];
+    for n in &tree.skeleton.internodes {
+        let slice = ((n.end.y / height) * 10.0).clamp(0.0, 9.0) as usize;
+        radius[slice] = radius[slice].max(n.end.x.hypot(n.end.z));
+    }
+    let widest = radius.iter().copied().fold(0.0, f32::max).max(1e-6);
+    radius[7].max(radius[8]) / widest
+}
+
+/// What a candidate grows on a set of seeds.
+struct Figures {
+    /// The worst deviation of a median: per stated figure, the median tree's relative deviation
+    /// (the suite holds these to 30%).
+    worst_median: f32,
+    /// The worst single tree's deviation (the suite holds it to 50%).
+    worst_tree: f32,
+    /// Mean internodes at 30 years.
+    internodes: f32,
+    /// The worst lean at 15 and 30 years.
+    lean: f32,
+    /// The median [`upper_crown`] at 30 years.
+    upper_crown: f32,
+}
+
+/// Bounds a candidate must keep.
+#[derive(Clone, Copy)]
+struct Limits {
+    /// A tree deviating more than this from a stated figure drops the candidate.
     give_up: f32,
     max_lean: f32,
-) -> Option<(f32, f32, f32, f32)> {
+    min_upper_crown: f32,
+}
+
+const NO_LIMITS: Limits = Limits {
+    give_up: f32::INFINITY,
+    max_lean: f32::INFINITY,
+    min_upper_crown: 0.0,
+};
+
+/// Grows `species` on `seeds`; `None` as soon as the candidate breaks `limits`.
+fn evaluate(species: &Species, seeds: &[u64], limits: Limits) -> Option<Figures> {
     let e = &species.expected;
     let mut measured: [Vec<f32>; 4] = Default::default();
     let mut expected = [0.0f32; 4];
     let (mut worst_tree, mut internodes, mut lean) = (0.0f32, 0usize, 0.0f32);
+    let mut upper = Vec::new();
     for &seed in seeds {
-        let [at10, at15, at30] = Tree::metrics_at_ages(species, seed, &[10.0, 15.0, 30.0])[..]
-        else {
-            unreachable!("three ages, three metrics")
-        };
+        let mut tree = Tree::new(species.clone(), seed);
+        let [at10, at15, at30] = [10.0, 15.0, 30.0].map(|age: f32| {
+            tree.grow_years(age - tree.age_years());
+            tree.metrics()
+        });
+        upper.push(upper_crown(&tree));
         lean = lean.max(at15.lean).max(at30.lean);
         internodes += at30.num_internodes;
         for (k, (_, m, x)) in e.against(&at10, &at30).into_iter().enumerate() {
@@ -48,32 +86,47 @@ fn evaluate(
             measured[k].push(m);
             expected[k] = x;
         }
-        if worst_tree > give_up || lean > max_lean {
+        if worst_tree > limits.give_up || lean > limits.max_lean {
             return None;
         }
     }
     let worst_median = measured
         .iter_mut()
         .zip(expected)
-        .map(|(values, x)| {
-            values.sort_by(f32::total_cmp);
-            (values[values.len() / 2] / x - 1.0).abs()
-        })
+        .map(|(values, x)| (median(values) / x - 1.0).abs())
         .fold(0.0f32, f32::max);
-    Some((
+    let upper_crown = median(&mut upper);
+    (upper_crown >= limits.min_upper_crown).then_some(Figures {
         worst_median,
         worst_tree,
-        internodes as f32 / seeds.len() as f32,
+        internodes: internodes as f32 / seeds.len() as f32,
         lean,
-    ))
+        upper_crown,
+    })
 }
 
-/// A candidate's figures (see [`evaluate`]) and the values drawn for it.
+fn median(values: &mut [f32]) -> f32 {
+    values.sort_by(f32::total_cmp);
+    values[values.len() / 2]
+}
+
+impl std::fmt::Display for Figures {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "median worst {:.0}% (tree {:.0}%, lean {:.2}, upper crown {:.2}, {:.0} internodes)",
+            self.worst_median * 100.0,
+            self.worst_tree * 100.0,
+            self.lean,
+            self.upper_crown,
+            self.internodes
+        )
+    }
+}
+
+/// A candidate's figures and the values drawn for it.
 struct Ranked {
-    worst_median: f32,
-    worst_tree: f32,
-    internodes: f32,
-    lean: f32,
+    figures: Figures,
     drawn: Vec<(String, f32)>,
 }
 
@@ -83,10 +136,13 @@ struct Range {
     hi: f32,
 }
 
-/// (samples, max_lean, ranges)
-fn parse_args(args: &[String]) -> Result<(usize, f32, Vec<Range>), String> {
+/// (samples, limits, ranges)
+fn parse_args(args: &[String]) -> Result<(usize, Limits, Vec<Range>), String> {
     let mut samples = 100;
-    let mut max_lean = f32::INFINITY;
+    let mut limits = Limits {
+        give_up: GIVE_UP,
+        ..NO_LIMITS
+    };
     let mut ranges = Vec::new();
     for arg in args {
         let (key, value) = arg
@@ -96,8 +152,13 @@ fn parse_args(args: &[String]) -> Result<(usize, f32, Vec<Range>), String> {
             samples = value.parse().map_err(|e| format!("{arg}: {e}"))?;
             continue;
         }
-        if key == "max_lean" {
-            max_lean = value.parse().map_err(|e| format!("{arg}: {e}"))?;
+        let limit = match key {
+            "max_lean" => Some(&mut limits.max_lean),
+            "min_upper_crown" => Some(&mut limits.min_upper_crown),
+            _ => None,
+        };
+        if let Some(limit) = limit {
+            *limit = value.parse().map_err(|e| format!("{arg}: {e}"))?;
             continue;
         }
         let (lo, hi) = value
@@ -110,7 +171,7 @@ fn parse_args(args: &[String]) -> Result<(usize, f32, Vec<Range>), String> {
             hi: parse(hi)?,
         });
     }
-    Ok((samples, max_lean, ranges))
+    Ok((samples, limits, ranges))
 }
 
 fn main() {
@@ -120,7 +181,7 @@ fn main() {
         std::process::exit(2);
     };
     let preset = Species::by_name(name).unwrap_or_else(|e| panic!("{e}"));
-    let (samples, max_lean, ranges) = parse_args(&args[1..]).unwrap_or_else(|e| panic!("{e}"));
+    let (samples, limits, ranges) = parse_args(&args[1..]).unwrap_or_else(|e| panic!("{e}"));
     let training: Vec<u64> = std::env::var("SYLVA_SEEDS").map_or(TRAINING_SEEDS.to_vec(), |l| {
         l.split(',')
             .map(|s| {
@@ -162,35 +223,18 @@ fn main() {
         if species.validate().is_err() {
             continue;
         }
-        if let Some((worst_median, worst_tree, internodes, lean)) =
-            evaluate(&species, &training, GIVE_UP, max_lean)
-        {
-            ranked.push(Ranked {
-                worst_median,
-                worst_tree,
-                internodes,
-                lean,
-                drawn,
-            });
+        if let Some(figures) = evaluate(&species, &training, limits) {
+            ranked.push(Ranked { figures, drawn });
             ranked.sort_by(|a, b| {
-                (a.worst_median.total_cmp(&b.worst_median))
-                    .then(a.worst_tree.total_cmp(&b.worst_tree))
+                (a.figures.worst_median.total_cmp(&b.figures.worst_median))
+                    .then(a.figures.worst_tree.total_cmp(&b.figures.worst_tree))
             });
             ranked.truncate(5);
         }
         if sample == 0 {
             match ranked.first() {
-                Some(r) => println!(
-                    "the preset: median worst {:.0}%, tree worst {:.0}%, {:.0} internodes at 30 years, lean {:.2}",
-                    r.worst_median * 100.0,
-                    r.worst_tree * 100.0,
-                    r.internodes,
-                    r.lean
-                ),
-                None => println!(
-                    "the preset: worse than {:.0}% on some seed, or leaning more than {max_lean}",
-                    GIVE_UP * 100.0
-                ),
+                Some(r) => println!("the preset: {}", r.figures),
+                None => println!("the preset: outside the limits on some seed"),
             }
         }
     }
@@ -201,17 +245,12 @@ fn main() {
             fields[f] = serde_json::json!(v);
         }
         let species: Species = serde_json::from_value(fields).expect("evaluated before");
-        let held_out = evaluate(&species, &HELD_OUT_SEEDS, f32::INFINITY, f32::INFINITY)
-            .map_or("-".to_owned(), |(w, t, _, lean)| {
-                format!("{:.0}% (tree {:.0}%, lean {lean:.2})", w * 100.0, t * 100.0)
-            });
+        let held_out = evaluate(&species, &HELD_OUT_SEEDS, NO_LIMITS)
+            .map_or("-".to_owned(), |f| f.to_string());
         let values: Vec<String> = r.drawn.iter().map(|(f, v)| format!("{f}={v}")).collect();
         println!(
-            "  median worst {:.0}% (tree {:.0}%, lean {:.2}), held out {held_out}, {:.0} internodes: {}",
-            r.worst_median * 100.0,
-            r.worst_tree * 100.0,
-            r.lean,
-            r.internodes,
+            "  {}\n    held out: {held_out}\n    {}",
+            r.figures,
             if values.is_empty() {
                 "the preset".to_owned()
             } else {
