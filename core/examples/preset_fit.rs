@@ -5,6 +5,9 @@
 //! `cargo run --release -p sylva-core --example preset_fit -- birch apical_dominance=0.56 ...`
 //! (values as JSON: numbers, `true`, `"spiral"`). `SYLVA_SEEDS=1,2,3` tries other seeds.
 
+#[path = "common/seeds.rs"]
+mod seeds;
+
 use sylva_core::Tree;
 use sylva_core::species::Species;
 
@@ -31,15 +34,7 @@ fn main() {
         std::process::exit(1);
     }
     let e = species.expected.clone();
-    let seeds: Vec<u64> = std::env::var("SYLVA_SEEDS").map_or(SEEDS.to_vec(), |list| {
-        list.split(',')
-            .map(|s| {
-                s.trim()
-                    .parse()
-                    .unwrap_or_else(|e| panic!("SYLVA_SEEDS {s}: {e}"))
-            })
-            .collect()
-    });
+    let seeds = seeds::seeds_from_env(&SEEDS);
     let (mut worst, mut worst_lean) = (0.0f32, 0.0f32);
     for seed in seeds {
         let [at10, at15, at30] = Tree::metrics_at_ages(&species, seed, &[10.0, 15.0, 30.0])[..]

@@ -12,6 +12,9 @@
 //!
 //! The preset itself is candidate 0, so the search reports how far it is from the best found.
 
+#[path = "common/seeds.rs"]
+mod seeds;
+
 use sylva_core::Tree;
 use sylva_core::rng::Rng;
 use sylva_core::species::Species;
@@ -182,15 +185,7 @@ fn main() {
     };
     let preset = Species::by_name(name).unwrap_or_else(|e| panic!("{e}"));
     let (samples, limits, ranges) = parse_args(&args[1..]).unwrap_or_else(|e| panic!("{e}"));
-    let training: Vec<u64> = std::env::var("SYLVA_SEEDS").map_or(TRAINING_SEEDS.to_vec(), |l| {
-        l.split(',')
-            .map(|s| {
-                s.trim()
-                    .parse()
-                    .unwrap_or_else(|e| panic!("SYLVA_SEEDS {s}: {e}"))
-            })
-            .collect()
-    });
+    let training = seeds::seeds_from_env(&TRAINING_SEEDS);
     let base = serde_json::to_value(&preset).expect("a species serializes");
     let mut rng = Rng::new(20141);
     let mut ranked: Vec<Ranked> = Vec::new();

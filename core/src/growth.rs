@@ -145,6 +145,12 @@ pub const MAX_TREE_EXTENT_M: f32 = 1000.0;
 /// The widest diameter a width constraint may ask for, metres (wider than any trunk).
 pub const MAX_WIDTH_CONSTRAINT_M: f32 = 10.0;
 
+/// Whether `diameter_m` is a diameter a width constraint may ask for: in (0,
+/// [`MAX_WIDTH_CONSTRAINT_M`]] metres.
+pub fn is_width_constraint(diameter_m: f32) -> bool {
+    diameter_m.is_finite() && diameter_m > 0.0 && diameter_m <= MAX_WIDTH_CONSTRAINT_M
+}
+
 /// Growth iterations a tree may have done (a thousand years at the shortest season a species
 /// may have): more means a damaged file.
 pub const MAX_ITERATIONS: u32 = 100_000;
@@ -438,7 +444,7 @@ impl Tree {
                 });
             }
             if let Some(d) = node.width_constraint
-                && !(d.is_finite() && d > 0.0 && d <= MAX_WIDTH_CONSTRAINT_M)
+                && !is_width_constraint(d)
             {
                 return Err(TreeInvariantError::Broken {
                     index,
@@ -477,7 +483,7 @@ impl Tree {
         let height = hi.y - base.y;
         TreeMetrics {
             num_internodes: nodes.len(),
-            height_m: hi.y - base.y,
+            height_m: height,
             crown_width_m: 0.5 * ((hi.x - lo.x) + (hi.z - lo.z)),
             trunk_diameter_m: nodes.first().map_or(0.0, |n| n.diameter),
             age_years: self.age_years(),

@@ -26,10 +26,10 @@ pub enum CameraError {
     Invalid { path: PathBuf, problem: String },
 }
 
-/// Intrinsics of a pinhole camera with radial-tangential distortion.
 /// The longest image side a camera file may give, pixels (beyond any phone or video camera).
 pub const MAX_IMAGE_SIDE: u32 = 16384;
 
+/// Intrinsics of a pinhole camera with radial-tangential distortion.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Camera {
     pub width: u32,

@@ -18,7 +18,7 @@ pub fn set_width_constraint(
         return Err(EditError::NoSuchInternode { id: node.0, count });
     }
     if let Some(d) = diameter_m
-        && !(d.is_finite() && d > 0.0 && d <= crate::growth::MAX_WIDTH_CONSTRAINT_M)
+        && !crate::growth::is_width_constraint(d)
     {
         return Err(EditError::BadParameter {
             name: "width constraint diameter",
