@@ -5,7 +5,11 @@
 //! in the suite), then grows the best five on six held-out seeds (101–106) so that a lucky fit
 //! shows. Prints each as arguments for `preset_fit`. A drawn tropism or environment weight (β,
 //! γ) sets the straightness α to 1 − β − γ. `max_lean=X` also drops candidates with a
-//! tree leaning more than X at 15 or 30 years (see `TreeMetrics::lean`).
+//! tree leaning more than X at 15 or 30 years (see `TreeMetrics::lean`). `field=json` (no
+//! range) sets a value every candidate takes, the preset (candidate 0) included.
+//! `min_upper_crown=X` drops candidates whose median crown is narrower near the top than X of
+//! its widest (see `upper_crown`), `min_hanging=X` those whose median tree hangs less than X of
+//! its internodes (see `hanging`).
 //!
 //! `cargo run --release -p sylva-core --example preset_search -- oak samples=200 \
 //!     apical_dominance=0.5..0.65 max_shoot_internodes=4..7`
@@ -38,6 +42,17 @@ fn upper_crown(tree: &Tree) -> f32 {
     radius[7].max(radius[8]) / widest
 }
 
+/// The share of internodes that hang: heading within 45° of straight down (a weeping tree's
+/// curtain; near 0 for most trees).
+fn hanging(tree: &Tree) -> f32 {
+    let nodes = &tree.skeleton.internodes;
+    let down = nodes
+        .iter()
+        .filter(|n| n.heading().y < -std::f32::consts::FRAC_1_SQRT_2)
+        .count();
+    down as f32 / nodes.len().max(1) as f32
+}
+
 /// What a candidate grows on a set of seeds.
 struct Figures {
     /// The worst deviation of a median: per stated figure, the median tree's relative deviation
@@ -51,6 +66,8 @@ struct Figures {
     lean: f32,
     /// The median [`upper_crown`] at 30 years.
     upper_crown: f32,
+    /// The median [`hanging`] share at 30 years.
+    hanging: f32,
 }
 
 /// Bounds a candidate must keep.
@@ -60,12 +77,14 @@ struct Limits {
     give_up: f32,
     max_lean: f32,
     min_upper_crown: f32,
+    min_hanging: f32,
 }
 
 const NO_LIMITS: Limits = Limits {
     give_up: f32::INFINITY,
     max_lean: f32::INFINITY,
     min_upper_crown: 0.0,
+    min_hanging: 0.0,
 };
 
 /// Grows `species` on `seeds`; `None` as soon as the candidate breaks `limits`.
@@ -74,7 +93,7 @@ fn evaluate(species: &Species, seeds: &[u64], limits: Limits) -> Option<Figures>
     let mut measured: [Vec<f32>; 4] = Default::default();
     let mut expected = [0.0f32; 4];
     let (mut worst_tree, mut internodes, mut lean) = (0.0f32, 0usize, 0.0f32);
-    let mut upper = Vec::new();
+    let (mut upper, mut hang) = (Vec::new(), Vec::new());
     for &seed in seeds {
         let mut tree = Tree::new(species.clone(), seed);
         let [at10, at15, at30] = [10.0, 15.0, 30.0].map(|age: f32| {
@@ -82,6 +101,7 @@ fn evaluate(species: &Species, seeds: &[u64], limits: Limits) -> Option<Figures>
             tree.metrics()
         });
         upper.push(upper_crown(&tree));
+        hang.push(hanging(&tree));
         lean = lean.max(at15.lean).max(at30.lean);
         internodes += at30.num_internodes;
         for (k, (_, m, x)) in e.against(&at10, &at30).into_iter().enumerate() {
@@ -99,12 +119,14 @@ fn evaluate(species: &Species, seeds: &[u64], limits: Limits) -> Option<Figures>
         .map(|(values, x)| (median(values) / x - 1.0).abs())
         .fold(0.0f32, f32::max);
     let upper_crown = median(&mut upper);
-    (upper_crown >= limits.min_upper_crown).then_some(Figures {
+    let hanging = median(&mut hang);
+    (upper_crown >= limits.min_upper_crown && hanging >= limits.min_hanging).then_some(Figures {
         worst_median,
         worst_tree,
         internodes: internodes as f32 / seeds.len() as f32,
         lean,
         upper_crown,
+        hanging,
     })
 }
 
@@ -117,11 +139,13 @@ impl std::fmt::Display for Figures {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         write!(
             f,
-            "median worst {:.0}% (tree {:.0}%, lean {:.2}, upper crown {:.2}, {:.0} internodes)",
+            "median worst {:.0}% (tree {:.0}%, lean {:.2}, upper crown {:.2}, hanging {:.2}, \
+             {:.0} internodes)",
             self.worst_median * 100.0,
             self.worst_tree * 100.0,
             self.lean,
             self.upper_crown,
+            self.hanging,
             self.internodes
         )
     }
@@ -139,9 +163,18 @@ struct Range {
     hi: f32,
 }
 
-/// (samples, limits, ranges)
-fn parse_args(args: &[String]) -> Result<(usize, Limits, Vec<Range>), String> {
+/// What the command line asks for.
+struct Search {
+    samples: usize,
+    limits: Limits,
+    ranges: Vec<Range>,
+    /// Values every candidate (the preset's too) takes: `field=json`.
+    fixed: Vec<(String, serde_json::Value)>,
+}
+
+fn parse_args(args: &[String]) -> Result<Search, String> {
     let mut samples = 100;
+    let mut fixed = Vec::new();
     let mut limits = Limits {
         give_up: GIVE_UP,
         ..NO_LIMITS
@@ -158,15 +191,18 @@ fn parse_args(args: &[String]) -> Result<(usize, Limits, Vec<Range>), String> {
         let limit = match key {
             "max_lean" => Some(&mut limits.max_lean),
             "min_upper_crown" => Some(&mut limits.min_upper_crown),
+            "min_hanging" => Some(&mut limits.min_hanging),
             _ => None,
         };
         if let Some(limit) = limit {
             *limit = value.parse().map_err(|e| format!("{arg}: {e}"))?;
             continue;
         }
-        let (lo, hi) = value
-            .split_once("..")
-            .ok_or_else(|| format!("{arg}: expected a range lo..hi"))?;
+        let Some((lo, hi)) = value.split_once("..") else {
+            let v = serde_json::from_str(value).map_err(|e| format!("{arg}: {e}"))?;
+            fixed.push((key.to_owned(), v));
+            continue;
+        };
         let parse = |s: &str| s.parse::<f32>().map_err(|e| format!("{arg}: {e}"));
         ranges.push(Range {
             field: key.to_owned(),
@@ -174,19 +210,32 @@ fn parse_args(args: &[String]) -> Result<(usize, Limits, Vec<Range>), String> {
             hi: parse(hi)?,
         });
     }
-    Ok((samples, limits, ranges))
+    Ok(Search {
+        samples,
+        limits,
+        ranges,
+        fixed,
+    })
 }
 
 fn main() {
     let args: Vec<String> = std::env::args().skip(1).collect();
     let Some(name) = args.first() else {
-        eprintln!("usage: preset_search PRESET [samples=N] [field=lo..hi ...]");
+        eprintln!("usage: preset_search PRESET [samples=N] [field=lo..hi | field=json ...]");
         std::process::exit(2);
     };
     let preset = Species::by_name(name).unwrap_or_else(|e| panic!("{e}"));
-    let (samples, limits, ranges) = parse_args(&args[1..]).unwrap_or_else(|e| panic!("{e}"));
+    let Search {
+        samples,
+        limits,
+        ranges,
+        fixed,
+    } = parse_args(&args[1..]).unwrap_or_else(|e| panic!("{e}"));
     let training = seeds::seeds_from_env(&TRAINING_SEEDS);
-    let base = serde_json::to_value(&preset).expect("a species serializes");
+    let mut base = serde_json::to_value(&preset).expect("a species serializes");
+    for (field, value) in &fixed {
+        base[field] = value.clone();
+    }
     let mut rng = Rng::new(20141);
     let mut ranked: Vec<Ranked> = Vec::new();
     for sample in 0..=samples {

@@ -113,6 +113,15 @@ pub struct Species {
     pub gravitropism_angle_deg: f32,
     /// The main axis (order 0) keeps an upward tropism while laterals use θ (conifers).
     pub upward_main_axis: bool,
+    /// Axes of branch order below this, the scaffold (the trunk and the main limbs), use the
+    /// set-point angle θ_s instead of θ; 0 (the default) gives every axis θ. Different branches
+    /// of one tree keep different set-point angles (Longay 2014 §4.4.2, after Hallé et al.):
+    /// a weeping tree raises a dome of ascending limbs from which its twigs hang.
+    #[serde(default, skip_serializing_if = "is_zero_u32")]
+    pub scaffold_orders: u32,
+    /// θ_s: gravitropic set-point angle of the scaffold axes (see `scaffold_orders`).
+    #[serde(default, skip_serializing_if = "is_zero_f32")]
+    pub scaffold_gravitropism_angle_deg: f32,
     /// ψ: angle between a lateral bud and its supporting axis.
     pub branching_angle_deg: f32,
     pub phyllotaxis: Phyllotaxis,
@@ -194,6 +203,17 @@ const PRESET_FILES: [(&str, &str); 6] = [
         include_str!("../species/lombardy_poplar.json"),
     ),
 ];
+
+/// The most branch orders a scaffold may span (far beyond any tree's main limbs).
+pub const MAX_SCAFFOLD_ORDERS: u32 = 16;
+
+fn is_zero_u32(v: &u32) -> bool {
+    *v == 0
+}
+
+fn is_zero_f32(v: &f32) -> bool {
+    *v == 0.0
+}
 
 /// The smallest internode and shadow voxel a species may have, metres.
 pub const MIN_VOXEL_M: f32 = 0.02;
@@ -337,6 +357,12 @@ impl Species {
                 0.0,
                 180.0,
             ),
+            (
+                "scaffold_gravitropism_angle_deg",
+                self.scaffold_gravitropism_angle_deg,
+                0.0,
+                180.0,
+            ),
             ("branching_angle_deg", self.branching_angle_deg, 0.0, 180.0),
             (
                 "phyllotactic_angle_deg",
@@ -387,6 +413,12 @@ impl Species {
             return Err(format!(
                 "buds_per_whorl must be 1..=12 for whorled phyllotaxis, got {}",
                 self.buds_per_whorl
+            ));
+        }
+        if self.scaffold_orders > MAX_SCAFFOLD_ORDERS {
+            return Err(format!(
+                "scaffold_orders must be at most {MAX_SCAFFOLD_ORDERS}, got {}",
+                self.scaffold_orders
             ));
         }
         if !(1..=64).contains(&self.max_points_per_bud) {

@@ -1,7 +1,10 @@
 //! Each parameter of the growth model has its documented effect, measured on grown trees against
 //! a baseline grown from the same seeds.
 
+mod support;
+
 use glam::Vec3;
+use support::mean_rise;
 use sylva_core::Tree;
 use sylva_core::growth::IterationStats;
 use sylva_core::species::Species;
@@ -108,6 +111,34 @@ fn a_gravitropic_angle_of_90_degrees_makes_laterals_nearer_horizontal_than_0_deg
     assert!(
         b < a,
         "mean |H·Y| of laterals: θ = 90° → {b:.3}, θ = 0° → {a:.3}"
+    );
+}
+
+#[test]
+fn an_ascending_scaffold_angle_raises_the_main_limbs_while_the_twigs_still_hang() {
+    let mut weeping = baseline();
+    weeping.gravitropism_angle_deg = 160.0;
+    weeping.upward_main_axis = true;
+    (
+        weeping.straightness,
+        weeping.tropism_weight,
+        weeping.environment_weight,
+    ) = (0.3, 0.4, 0.3);
+    let mut scaffold = weeping.clone();
+    scaffold.scaffold_orders = 2;
+    scaffold.scaffold_gravitropism_angle_deg = 30.0;
+    let limbs = |s: &Species| mean_over_seeds(s, |t, _| f64::from(mean_rise(t, 1..=1)));
+    let twigs = |s: &Species| mean_over_seeds(s, |t, _| f64::from(mean_rise(t, 2..=u32::MAX)));
+    let (flat_limbs, raised_limbs) = (limbs(&weeping), limbs(&scaffold));
+    assert!(
+        raised_limbs > flat_limbs + 0.3 && raised_limbs > 0.3,
+        "mean H·Y of first-order limbs: scaffold θ_s = 30° → {raised_limbs:.2}, \
+         none → {flat_limbs:.2}"
+    );
+    let hanging = twigs(&scaffold);
+    assert!(
+        hanging < 0.0,
+        "twigs above the scaffold's orders still hang (θ = 160°): mean H·Y {hanging:.2}"
     );
 }
 

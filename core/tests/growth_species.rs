@@ -2,6 +2,9 @@
 //! years (the tree of seed 2014 and the median tree of five seeds; no seed's tree beyond ±50%),
 //! stands upright, and keeps its botanical character.
 
+mod support;
+
+use support::mean_rise;
 use sylva_core::Tree;
 use sylva_core::species::Species;
 
@@ -87,17 +90,6 @@ fn every_preset_lands_within_30_percent_of_its_stated_height_and_spread_at_10_an
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
-fn mean_vertical(tree: &Tree, orders: std::ops::RangeInclusive<u32>) -> f32 {
-    let ys: Vec<f32> = tree
-        .skeleton
-        .internodes
-        .iter()
-        .filter(|n| orders.contains(&n.order))
-        .map(|n| n.heading().y)
-        .collect();
-    ys.iter().sum::<f32>() / ys.len().max(1) as f32
-}
-
 #[test]
 fn presets_keep_their_botanical_character() {
     let grown = |name: &str| {
@@ -106,7 +98,7 @@ fn presets_keep_their_botanical_character() {
         tree
     };
     let spruce = grown("norway_spruce");
-    let (trunk, laterals) = (mean_vertical(&spruce, 0..=0), mean_vertical(&spruce, 1..=1));
+    let (trunk, laterals) = (mean_rise(&spruce, 0..=0), mean_rise(&spruce, 1..=1));
     println!("spruce trunk H·Y {trunk:.3}, first-order laterals H·Y {laterals:.3}");
     assert!(
         trunk > 0.97,
@@ -117,7 +109,7 @@ fn presets_keep_their_botanical_character() {
         "spruce laterals not plagiotropic: mean H·Y {laterals:.3}"
     );
     let willow = grown("weeping_willow");
-    let hanging = mean_vertical(&willow, 2..=u32::MAX);
+    let hanging = mean_rise(&willow, 2..=u32::MAX);
     println!("willow higher-order H·Y {hanging:.3}");
     assert!(
         hanging < -0.2,

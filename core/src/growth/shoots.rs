@@ -107,7 +107,8 @@ fn deflect(
 }
 
 /// T: the per-bud override, else the tropism carried by the points, else gravitropism — global
-/// up rotated by θ in the vertical plane holding H (upward for the main axis of conifers).
+/// up rotated by θ (θ_s on the scaffold's orders) in the vertical plane holding H (upward for
+/// the main axis of conifers).
 fn tropism(tree: &mut Tree, heading: Vec3, order: u32, chosen: Option<Vec3>) -> Vec3 {
     if let Some(t) = chosen {
         return t;
@@ -116,7 +117,12 @@ fn tropism(tree: &mut Tree, heading: Vec3, order: u32, chosen: Option<Vec3>) -> 
     if s.upward_main_axis && order == 0 {
         return Vec3::Y;
     }
-    let (sin_t, cos_t) = s.gravitropism_angle_deg.to_radians().sin_cos();
+    let theta = if order < s.scaffold_orders {
+        s.scaffold_gravitropism_angle_deg
+    } else {
+        s.gravitropism_angle_deg
+    };
+    let (sin_t, cos_t) = theta.to_radians().sin_cos();
     let horizontal = Vec3::new(heading.x, 0.0, heading.z)
         .try_normalize()
         .unwrap_or_else(|| {

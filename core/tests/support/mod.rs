@@ -1,5 +1,6 @@
-//! Helpers shared by the geometry and export tests: the crack check, the Khronos validator and
-//! the re-import check. Each test file uses some of them.
+//! Helpers shared by the tests: the crack check, the Khronos validator and the re-import check
+//! of the geometry and export tests, and measures of grown trees. Each test file uses some of
+//! them.
 #![allow(dead_code)]
 
 use std::path::{Path, PathBuf};
@@ -176,4 +177,16 @@ pub fn assert_no_cracks(skeleton: &Skeleton, meshes: &TreeMeshes, tip_taper: f32
         }
     }
     checked
+}
+
+/// Mean H·Y (signed: up > 0) of the internodes whose branch order lies in `orders`.
+pub fn mean_rise(tree: &sylva_core::Tree, orders: std::ops::RangeInclusive<u32>) -> f32 {
+    let rises: Vec<f32> = tree
+        .skeleton
+        .internodes
+        .iter()
+        .filter(|n| orders.contains(&n.order))
+        .map(|n| n.heading().y)
+        .collect();
+    rises.iter().sum::<f32>() / rises.len().max(1) as f32
 }
