@@ -9,7 +9,9 @@
 //! range) sets a value every candidate takes, the preset (candidate 0) included.
 //! `min_upper_crown=X` drops candidates whose median crown is narrower near the top than X of
 //! its widest (see `upper_crown`), `min_hanging=X` those whose median tree hangs less than X of
-//! its internodes (see `hanging`).
+//! its internodes (see `hanging`), `min_internodes=N` those growing fewer than N internodes at
+//! 30 years on average (a sparse crown), `min_slender=X` those whose median tree is less than X
+//! times as tall as it is wide at 15 years.
 //!
 //! `cargo run --release -p sylva-core --example preset_search -- oak samples=200 \
 //!     apical_dominance=0.5..0.65 max_shoot_internodes=4..7`
@@ -78,6 +80,10 @@ struct Limits {
     max_lean: f32,
     min_upper_crown: f32,
     min_hanging: f32,
+    /// Fewest mean internodes at 30 years (a dense crown).
+    min_internodes: f32,
+    /// Least median height over spread at 15 years (a column).
+    min_slender: f32,
 }
 
 const NO_LIMITS: Limits = Limits {
@@ -85,6 +91,8 @@ const NO_LIMITS: Limits = Limits {
     max_lean: f32::INFINITY,
     min_upper_crown: 0.0,
     min_hanging: 0.0,
+    min_internodes: 0.0,
+    min_slender: 0.0,
 };
 
 /// Grows `species` on `seeds`; `None` as soon as the candidate breaks `limits`.
@@ -93,7 +101,7 @@ fn evaluate(species: &Species, seeds: &[u64], limits: Limits) -> Option<Figures>
     let mut measured: [Vec<f32>; 4] = Default::default();
     let mut expected = [0.0f32; 4];
     let (mut worst_tree, mut internodes, mut lean) = (0.0f32, 0usize, 0.0f32);
-    let (mut upper, mut hang) = (Vec::new(), Vec::new());
+    let (mut upper, mut hang, mut slender) = (Vec::new(), Vec::new(), Vec::new());
     for &seed in seeds {
         let mut tree = Tree::new(species.clone(), seed);
         let [at10, at15, at30] = [10.0, 15.0, 30.0].map(|age: f32| {
@@ -102,6 +110,7 @@ fn evaluate(species: &Species, seeds: &[u64], limits: Limits) -> Option<Figures>
         });
         upper.push(upper_crown(&tree));
         hang.push(hanging(&tree));
+        slender.push(at15.height_m / at15.crown_width_m.max(1e-6));
         lean = lean.max(at15.lean).max(at30.lean);
         internodes += at30.num_internodes;
         for (k, (_, m, x)) in e.against(&at10, &at30).into_iter().enumerate() {
@@ -120,10 +129,15 @@ fn evaluate(species: &Species, seeds: &[u64], limits: Limits) -> Option<Figures>
         .fold(0.0f32, f32::max);
     let upper_crown = median(&mut upper);
     let hanging = median(&mut hang);
-    (upper_crown >= limits.min_upper_crown && hanging >= limits.min_hanging).then_some(Figures {
+    let internodes = internodes as f32 / seeds.len() as f32;
+    let kept = upper_crown >= limits.min_upper_crown
+        && hanging >= limits.min_hanging
+        && internodes >= limits.min_internodes
+        && median(&mut slender) >= limits.min_slender;
+    kept.then_some(Figures {
         worst_median,
         worst_tree,
-        internodes: internodes as f32 / seeds.len() as f32,
+        internodes,
         lean,
         upper_crown,
         hanging,
@@ -192,6 +206,8 @@ fn parse_args(args: &[String]) -> Result<Search, String> {
             "max_lean" => Some(&mut limits.max_lean),
             "min_upper_crown" => Some(&mut limits.min_upper_crown),
             "min_hanging" => Some(&mut limits.min_hanging),
+            "min_internodes" => Some(&mut limits.min_internodes),
+            "min_slender" => Some(&mut limits.min_slender),
             _ => None,
         };
         if let Some(limit) = limit {
