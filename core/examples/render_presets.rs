@@ -100,9 +100,13 @@ fn fill(target: &mut Target, [a, b, c]: [ScreenVertex; 3], texture: &RgbaImage, 
         .max(c.pixel)
         .min(Vec2::new(WIDTH as f32 - 1.0, HEIGHT as f32 - 1.0))
         .ceil();
+    // A triangle wholly off the image has an empty box.
+    if lo.x > hi.x || lo.y > hi.y {
+        return;
+    }
     let (tw, th) = (texture.width() as f32, texture.height() as f32);
-    for y in lo.y as u32..=hi.y.max(lo.y) as u32 {
-        for x in lo.x as u32..=hi.x.max(lo.x) as u32 {
+    for y in lo.y as u32..=hi.y as u32 {
+        for x in lo.x as u32..=hi.x as u32 {
             let p = Vec2::new(x as f32 + 0.5, y as f32 + 0.5);
             let wa = (b.pixel - p).perp_dot(c.pixel - p) / area;
             let wb = (c.pixel - p).perp_dot(a.pixel - p) / area;
