@@ -292,9 +292,14 @@ fn main() {
             ranked.truncate(5);
         }
         if sample == 0 {
+            let what = if fixed.is_empty() {
+                "the preset"
+            } else {
+                "the preset with the fixed values"
+            };
             match ranked.first() {
-                Some(r) => println!("the preset: {}", r.figures),
-                None => println!("the preset: outside the limits on some seed"),
+                Some(r) => println!("{what}: {}", r.figures),
+                None => println!("{what}: outside the limits on some seed"),
             }
         }
     }
@@ -307,7 +312,10 @@ fn main() {
         let species: Species = serde_json::from_value(fields).expect("evaluated before");
         let held_out = evaluate(&species, &HELD_OUT_SEEDS, NO_LIMITS)
             .map_or("-".to_owned(), |f| f.to_string());
-        let values: Vec<String> = r.drawn.iter().map(|(f, v)| format!("{f}={v}")).collect();
+        // Arguments for `preset_fit`: the fixed values, then the drawn ones.
+        let fixed_values = fixed.iter().map(|(f, v)| format!("{f}={v}"));
+        let drawn_values = r.drawn.iter().map(|(f, v)| format!("{f}={v}"));
+        let values: Vec<String> = fixed_values.chain(drawn_values).collect();
         println!(
             "  {}\n    held out: {held_out}\n    {}",
             r.figures,

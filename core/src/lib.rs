@@ -27,3 +27,9 @@ pub mod tree;
 pub use growth::Tree;
 pub use rng::Rng;
 pub use tree::{Bud, Internode, NodeId, Skeleton};
+
+/// `skip_serializing_if` for optional fields whose default means "not used": files leave them
+/// out, so they stay as they were before the field existed.
+pub(crate) fn is_default<T: Default + PartialEq>(value: &T) -> bool {
+    *value == T::default()
+}

@@ -117,10 +117,10 @@ pub struct Species {
     /// set-point angle θ_s instead of θ; 0 (the default) gives every axis θ. Different branches
     /// of one tree keep different set-point angles (Longay 2014 §4.4.2, after Hallé et al.):
     /// a weeping tree raises a dome of ascending limbs from which its twigs hang.
-    #[serde(default, skip_serializing_if = "is_zero_u32")]
+    #[serde(default, skip_serializing_if = "crate::is_default")]
     pub scaffold_orders: u32,
     /// θ_s: gravitropic set-point angle of the scaffold axes (see `scaffold_orders`).
-    #[serde(default, skip_serializing_if = "is_zero_f32")]
+    #[serde(default, skip_serializing_if = "crate::is_default")]
     pub scaffold_gravitropism_angle_deg: f32,
     /// ψ: angle between a lateral bud and its supporting axis.
     pub branching_angle_deg: f32,
@@ -206,14 +206,6 @@ const PRESET_FILES: [(&str, &str); 6] = [
 
 /// The most branch orders a scaffold may span (far beyond any tree's main limbs).
 pub const MAX_SCAFFOLD_ORDERS: u32 = 16;
-
-fn is_zero_u32(v: &u32) -> bool {
-    *v == 0
-}
-
-fn is_zero_f32(v: &f32) -> bool {
-    *v == 0.0
-}
 
 /// The smallest internode and shadow voxel a species may have, metres.
 pub const MIN_VOXEL_M: f32 = 0.02;

@@ -27,12 +27,8 @@ pub struct AttractionPoints {
     /// Sketch-based tropism: a bud fed by points that carry a stroke direction weighs that
     /// direction (T) at least this much in H' = αH + βT + γE, so branches follow strokes even
     /// on species with little tropism (β). 0 when no stroke asks for it.
-    #[serde(default, skip_serializing_if = "is_zero")]
+    #[serde(default, skip_serializing_if = "crate::is_default")]
     pub sketch_tropism_weight: f32,
-}
-
-fn is_zero(x: &f32) -> bool {
-    *x == 0.0
 }
 
 impl AttractionPoints {
