@@ -40,6 +40,77 @@ fn axis_gap(v: i32, b: i32) -> i32 {
     (first - v).max(v - (first + BRICK - 1)).max(0)
 }
 
+/// Asks the CPU to bring the cache line holding `value` closer (a hint: it changes nothing
+/// else, and does nothing on targets without the instruction).
+#[inline(always)]
+fn prefetch<T>(value: &T) {
+    #[cfg(target_arch = "x86_64")]
+    // SAFETY: a prefetch only hints at the cache; it never faults and reads or writes nothing
+    // that the program sees, and the address comes from a live reference.
+    unsafe {
+        use std::arch::x86_64::{_MM_HINT_T0, _mm_prefetch};
+        _mm_prefetch::<_MM_HINT_T0>(std::ptr::from_ref(value).cast());
+    }
+    #[cfg(not(target_arch = "x86_64"))]
+    let _ = value;
+}
+
+/// Calls `f(brick, levels)` for every brick the shadow pyramid of a node in voxel `top` (levels
+/// q = 0..=`q_max`) reaches, with the levels whose square lies partly in it.
+#[inline(always)]
+fn for_each_pyramid_brick(
+    top: IVec3,
+    q_max: i32,
+    mut f: impl FnMut(IVec3, std::ops::RangeInclusive<i32>),
+) {
+    let lo = top - IVec3::splat(q_max);
+    let hi = top + IVec3::new(q_max, 0, q_max);
+    for by in (lo.y >> BRICK_SHIFT)..=(hi.y >> BRICK_SHIFT) {
+        // Levels whose layer y = top.y − q lies in this brick layer.
+        let q_lo = top.y - hi.y.min((by << BRICK_SHIFT) + BRICK - 1);
+        let q_hi = top.y - lo.y.max(by << BRICK_SHIFT);
+        for bz in (lo.z >> BRICK_SHIFT)..=(hi.z >> BRICK_SHIFT) {
+            let gap_z = axis_gap(top.z, bz);
+            for bx in (lo.x >> BRICK_SHIFT)..=(hi.x >> BRICK_SHIFT) {
+                // The smallest level whose square reaches this brick column.
+                let q_first = q_lo.max(gap_z).max(axis_gap(top.x, bx));
+                if q_first <= q_hi {
+                    f(IVec3::new(bx, by, bz), q_first..=q_hi);
+                }
+            }
+        }
+    }
+}
+
+/// The part of a pyramid level's square (half-width q around the node's column) inside one
+/// brick, in the brick's own columns x0..=x1 and rows z0..=z1.
+struct Square {
+    x0: usize,
+    x1: usize,
+    z0: usize,
+    z1: usize,
+}
+
+impl Square {
+    #[inline(always)]
+    fn of_level(top: IVec3, q: i32, brick: IVec3) -> Square {
+        let first = brick << BRICK_SHIFT;
+        let last = first + IVec3::splat(BRICK - 1);
+        let local = |v: i32| (v & (BRICK - 1)) as usize;
+        Square {
+            x0: local((top.x - q).max(first.x)),
+            x1: local((top.x + q).min(last.x)),
+            z0: local((top.z - q).max(first.z)),
+            z1: local((top.z + q).min(last.z)),
+        }
+    }
+
+    /// The row after the square's last (row 0 when the square runs to the brick's end).
+    fn end_row(&self) -> usize {
+        (self.z1 + 1) & (ROW - 1)
+    }
+}
+
 /// Voxels in one row of a brick (along x).
 const ROW: usize = BRICK as usize;
 /// `COLUMN_MASKS[x0][x1]`: all ones in lanes x0..=x1 of a brick row, zero elsewhere.
@@ -86,6 +157,9 @@ pub struct ShadowGrid {
     /// fastest, then z, then y.
     chunks: Vec<Box<[Layer]>>,
     num_bricks: usize,
+    /// Working memory of [`ShadowGrid::apply_node`]: the bricks a pyramid reaches (index,
+    /// brick coordinates, levels in it).
+    reached: Vec<(usize, IVec3, std::ops::RangeInclusive<i32>)>,
 }
 
 impl ShadowGrid {
@@ -161,6 +235,8 @@ impl ShadowGrid {
     /// lie in it add Δs, masked to their square's columns, on the row where the square starts in
     /// the brick and take it off the row after the one where it ends (if that row is in the
     /// brick): two fixed 8-wide updates per level and brick, no loop over the square's rows.
+    /// A first pass over the same rows only asks for their cache lines, so that the second
+    /// waits on memory once for all of them rather than once per row.
     pub fn apply_node(&mut self, node_in_world: Vec3, sign: i32) {
         if self.level_units.is_empty() || !node_in_world.is_finite() {
             return;
@@ -175,44 +251,38 @@ impl ShadowGrid {
         let lo = top - IVec3::splat(q_max);
         let hi = top + IVec3::new(q_max, 0, q_max);
         self.ensure_index_covers(lo >> BRICK_SHIFT, hi >> BRICK_SHIFT);
-        for by in (lo.y >> BRICK_SHIFT)..=(hi.y >> BRICK_SHIFT) {
-            // Levels whose layer y = top.y − q lies in this brick layer.
-            let q_lo = top.y - hi.y.min((by << BRICK_SHIFT) + BRICK - 1);
-            let q_hi = top.y - lo.y.max(by << BRICK_SHIFT);
-            for bz in (lo.z >> BRICK_SHIFT)..=(hi.z >> BRICK_SHIFT) {
-                let gap_z = axis_gap(top.z, bz);
-                for bx in (lo.x >> BRICK_SHIFT)..=(hi.x >> BRICK_SHIFT) {
-                    // The smallest level whose square reaches this brick column.
-                    let q_first = q_lo.max(gap_z).max(axis_gap(top.x, bx));
-                    if q_first > q_hi {
-                        continue;
-                    }
-                    let brick = self.brick_at(IVec3::new(bx, by, bz));
-                    let (units, layers) = self.brick_layers_mut(brick);
-                    for q in q_first..=q_hi {
-                        let delta = sign * units[q as usize];
-                        let layer = &mut layers[((top.y - q) & (BRICK - 1)) as usize].0;
-                        let x0 = ((top.x - q).max(bx << BRICK_SHIFT) & (BRICK - 1)) as usize;
-                        let x1 = ((top.x + q).min((bx << BRICK_SHIFT) + BRICK - 1) & (BRICK - 1))
-                            as usize;
-                        let z0 = ((top.z - q).max(bz << BRICK_SHIFT) & (BRICK - 1)) as usize;
-                        let z1 = ((top.z + q).min((bz << BRICK_SHIFT) + BRICK - 1) & (BRICK - 1))
-                            as usize;
-                        // A square that runs to the brick's last row has no row after it here:
-                        // the update then lands on row 0 with nothing to take off (no branch).
-                        let end_delta = if z1 + 1 < ROW { delta } else { 0 };
-                        let end_row = (z1 + 1) & (ROW - 1);
-                        let columns = &COLUMN_MASKS[x0][x1];
-                        for (value, &m) in layer[z0].iter_mut().zip(columns) {
-                            *value = value.wrapping_add(delta & m);
-                        }
-                        for (value, &m) in layer[end_row].iter_mut().zip(columns) {
-                            *value = value.wrapping_sub(end_delta & m);
-                        }
-                    }
+        let mut reached = std::mem::take(&mut self.reached);
+        reached.clear();
+        for_each_pyramid_brick(top, q_max, |b, levels| {
+            let brick = self.brick_at(b);
+            let (_, layers) = self.brick_layers_mut(brick);
+            for q in levels.clone() {
+                let square = Square::of_level(top, q, b);
+                let layer = &layers[((top.y - q) & (BRICK - 1)) as usize].0;
+                prefetch(&layer[square.z0]);
+                prefetch(&layer[square.end_row()]);
+            }
+            reached.push((brick, b, levels));
+        });
+        for (brick, b, levels) in reached.drain(..) {
+            let (units, layers) = self.brick_layers_mut(brick);
+            for q in levels {
+                let square = Square::of_level(top, q, b);
+                let delta = sign * units[q as usize];
+                let layer = &mut layers[((top.y - q) & (BRICK - 1)) as usize].0;
+                // A square that runs to the brick's last row has no row after it here: the
+                // update then lands on row 0 with nothing to take off (no branch).
+                let end_delta = if square.z1 + 1 < ROW { delta } else { 0 };
+                let columns = &COLUMN_MASKS[square.x0][square.x1];
+                for (value, &m) in layer[square.z0].iter_mut().zip(columns) {
+                    *value = value.wrapping_add(delta & m);
+                }
+                for (value, &m) in layer[square.end_row()].iter_mut().zip(columns) {
+                    *value = value.wrapping_sub(end_delta & m);
                 }
             }
         }
+        self.reached = reached;
     }
 
     /// [`ShadowGrid::apply_node`] for many nodes: the same grid as one call each (integer
