@@ -160,7 +160,7 @@ impl Candidates {
         mut accept: impl FnMut(u32, Vec3, f32) -> Option<T>,
     ) -> Option<(T, f32)> {
         let r2 = radius * radius;
-        self.d2.clear();
+        // Every block of distances is written below: only the length needs setting.
         self.d2.resize(self.index.len(), f32::INFINITY);
         // The distances, stored block by block with each lane's smallest.
         let mut lanes = [f32::INFINITY; LANES];
