@@ -111,9 +111,8 @@ impl SpatialGrid {
             self.entry_y.extend(self.entry_position.iter().map(|p| p.y));
             self.entry_z.extend(self.entry_position.iter().map(|p| p.z));
         }
-        for c in (1..=num_cells).rev() {
-            self.cell_start[c] = self.cell_start[c - 1];
-        }
+        // The cursors ended at each cell's end: shifted by one cell they are the starts.
+        self.cell_start.copy_within(0..num_cells, 1);
         self.cell_start[0] = 0;
     }
 
