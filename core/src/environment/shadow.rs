@@ -238,21 +238,35 @@ impl ShadowGrid {
     /// A first pass over the same rows only asks for their cache lines, so that the second
     /// waits on memory once for all of them rather than once per row.
     pub fn apply_node(&mut self, node_in_world: Vec3, sign: i32) {
+        let mut reached = std::mem::take(&mut self.reached);
+        if let Some(top) = self.plan_pyramid(node_in_world, &mut reached) {
+            self.add_pyramid(top, &reached, sign);
+        }
+        self.reached = reached;
+    }
+
+    /// The first pass of [`ShadowGrid::apply_node`]: the voxel of the node, and in `reached`
+    /// the bricks its pyramid reaches (allocated if new) with the levels in each, their rows
+    /// asked for; `None` when the node casts no shade.
+    fn plan_pyramid(
+        &mut self,
+        node_in_world: Vec3,
+        reached: &mut Vec<(usize, IVec3, std::ops::RangeInclusive<i32>)>,
+    ) -> Option<IVec3> {
+        reached.clear();
         if self.level_units.is_empty() || !node_in_world.is_finite() {
-            return;
+            return None;
         }
         let q_max = (self.level_units.len() - 1) as i32;
         let top = self.voxel_of(node_in_world);
         if top.cmplt(IVec3::splat(-MAX_VOXEL_COORD)).any()
             || top.cmpgt(IVec3::splat(MAX_VOXEL_COORD)).any()
         {
-            return;
+            return None;
         }
         let lo = top - IVec3::splat(q_max);
         let hi = top + IVec3::new(q_max, 0, q_max);
         self.ensure_index_covers(lo >> BRICK_SHIFT, hi >> BRICK_SHIFT);
-        let mut reached = std::mem::take(&mut self.reached);
-        reached.clear();
         for_each_pyramid_brick(top, q_max, |b, levels| {
             let brick = self.brick_at(b);
             let (_, layers) = self.brick_layers_mut(brick);
@@ -264,10 +278,21 @@ impl ShadowGrid {
             }
             reached.push((brick, b, levels));
         });
-        for (brick, b, levels) in reached.drain(..) {
-            let (units, layers) = self.brick_layers_mut(brick);
-            for q in levels {
-                let square = Square::of_level(top, q, b);
+        Some(top)
+    }
+
+    /// The second pass of [`ShadowGrid::apply_node`]: the row updates of the pyramid of a node
+    /// in voxel `top` over the bricks `reached` that [`ShadowGrid::plan_pyramid`] found.
+    fn add_pyramid(
+        &mut self,
+        top: IVec3,
+        reached: &[(usize, IVec3, std::ops::RangeInclusive<i32>)],
+        sign: i32,
+    ) {
+        for (brick, b, levels) in reached {
+            let (units, layers) = self.brick_layers_mut(*brick);
+            for q in levels.clone() {
+                let square = Square::of_level(top, q, *b);
                 let delta = sign * units[q as usize];
                 let layer = &mut layers[((top.y - q) & (BRICK - 1)) as usize].0;
                 // A square that runs to the brick's last row has no row after it here: the
@@ -282,12 +307,12 @@ impl ShadowGrid {
                 }
             }
         }
-        self.reached = reached;
     }
 
     /// [`ShadowGrid::apply_node`] for many nodes: the same grid as one call each (integer
     /// sums do not depend on the order), made in brick order so that neighbouring pyramids
-    /// find their bricks in cache.
+    /// find their bricks in cache, and each node's rows asked for while the previous node's
+    /// are updated.
     pub fn apply_nodes(&mut self, nodes: impl IntoIterator<Item = Vec3>, sign: i32) {
         let mut keyed: Vec<(u64, Vec3)> = nodes
             .into_iter()
@@ -299,9 +324,23 @@ impl ShadowGrid {
             })
             .collect();
         keyed.sort_unstable_by_key(|&(key, _)| key);
+        let mut current = std::mem::take(&mut self.reached);
+        let mut next = Vec::with_capacity(current.capacity());
+        let mut pending = None;
         for (_, p) in keyed {
-            self.apply_node(p, sign);
+            // Bricks never move once allocated: planning the next pyramid leaves the current
+            // one's brick indices valid.
+            let planned = self.plan_pyramid(p, &mut next);
+            if let Some(top) = pending {
+                self.add_pyramid(top, &current, sign);
+            }
+            std::mem::swap(&mut current, &mut next);
+            pending = planned;
         }
+        if let Some(top) = pending {
+            self.add_pyramid(top, &current, sign);
+        }
+        self.reached = current;
     }
 
     /// The layers (y = 0..8) of brick `brick`, with Δs of every level.
