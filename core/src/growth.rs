@@ -197,7 +197,7 @@ impl Tree {
             light_exposure: tree.species.full_exposure,
         };
         let azimuth = tree.rng.range_f32(0.0, std::f32::consts::TAU);
-        buds::add_lateral_buds(&tree.species, &mut seedling, azimuth);
+        buds::LateralBudPlacement::of(&tree.species).add_to(&mut seedling, azimuth);
         tree.environment.shadow.apply_node(seedling.end, 1);
         tree.skeleton.internodes.push(seedling);
         tree.update_widths();

@@ -174,21 +174,40 @@ pub(crate) fn next_azimuth(species: &Species, previous: Option<f32>, random: f32
     previous.map_or(random, |a| a + azimuth_step(species))
 }
 
-/// Adds the lateral buds of a new internode, the first at `azimuth` around its heading.
-pub(crate) fn add_lateral_buds(species: &Species, node: &mut Internode, azimuth: f32) {
-    let h = node.heading();
-    let l = node.left;
-    let u = h.cross(l);
-    let (sin_psi, cos_psi) = species.branching_angle_deg.to_radians().sin_cos();
-    let k = species.buds_per_node();
-    node.lateral_buds.clear();
-    for j in 0..k {
-        let az = azimuth + j as f32 * std::f32::consts::TAU / k as f32;
-        let (s, c) = az.sin_cos();
-        let dir = (cos_psi * h + sin_psi * (c * l + s * u))
-            .try_normalize()
-            .unwrap_or(h);
-        node.lateral_buds.push(crate::tree::Bud::new(dir));
+/// Where a species places the lateral buds of a new internode: k buds at branching angle ψ from
+/// the heading (sin ψ and cos ψ worked out once for all the internodes of an iteration).
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LateralBudPlacement {
+    sin_psi: f32,
+    cos_psi: f32,
+    buds: u32,
+}
+
+impl LateralBudPlacement {
+    pub(crate) fn of(species: &Species) -> Self {
+        let (sin_psi, cos_psi) = species.branching_angle_deg.to_radians().sin_cos();
+        LateralBudPlacement {
+            sin_psi,
+            cos_psi,
+            buds: species.buds_per_node(),
+        }
+    }
+
+    /// Adds the lateral buds of a new internode, the first at `azimuth` around its heading.
+    pub(crate) fn add_to(&self, node: &mut Internode, azimuth: f32) {
+        let h = node.heading();
+        let l = node.left;
+        let u = h.cross(l);
+        let k = self.buds;
+        node.lateral_buds.clear();
+        for j in 0..k {
+            let az = azimuth + j as f32 * std::f32::consts::TAU / k as f32;
+            let (s, c) = az.sin_cos();
+            let dir = (self.cos_psi * h + self.sin_psi * (c * l + s * u))
+                .try_normalize()
+                .unwrap_or(h);
+            node.lateral_buds.push(crate::tree::Bud::new(dir));
+        }
     }
 }
 

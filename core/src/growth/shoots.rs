@@ -52,6 +52,7 @@ pub(crate) fn grow_all(
         _ => None,
     };
     let num_before = tree.skeleton.len();
+    let angles = ShootAngles::of(&tree.species);
     let (mut shoots, mut added) = (0, 0);
     for (i, &gone) in removed.iter().enumerate().take(num_before) {
         if gone {
@@ -66,7 +67,7 @@ pub(crate) fn grow_all(
             }
             let n = shoot_length(bud.vigor, v_max, n_max);
             if n > 0 {
-                let grown = grow_shoot(tree, scratch, bi, n, front);
+                let grown = grow_shoot(tree, scratch, &angles, bi, n, front);
                 shoots += usize::from(grown > 0);
                 added += grown;
             }
@@ -106,10 +107,35 @@ fn deflect(
     }
 }
 
+/// The angles every shoot of an iteration grows by, their sines and cosines worked out once.
+struct ShootAngles {
+    /// sin and cos of the gravitropic set-point angle θ.
+    theta: (f32, f32),
+    /// sin and cos of the scaffold's set-point angle θ_s.
+    scaffold_theta: (f32, f32),
+    lateral_buds: buds::LateralBudPlacement,
+}
+
+impl ShootAngles {
+    fn of(s: &crate::species::Species) -> Self {
+        ShootAngles {
+            theta: s.gravitropism_angle_deg.to_radians().sin_cos(),
+            scaffold_theta: s.scaffold_gravitropism_angle_deg.to_radians().sin_cos(),
+            lateral_buds: buds::LateralBudPlacement::of(s),
+        }
+    }
+}
+
 /// T: the per-bud override, else the tropism carried by the points, else gravitropism — global
 /// up rotated by θ (θ_s on the scaffold's orders) in the vertical plane holding H (upward for
 /// the main axis of conifers).
-fn tropism(tree: &mut Tree, heading: Vec3, order: u32, chosen: Option<Vec3>) -> Vec3 {
+fn tropism(
+    tree: &mut Tree,
+    angles: &ShootAngles,
+    heading: Vec3,
+    order: u32,
+    chosen: Option<Vec3>,
+) -> Vec3 {
     if let Some(t) = chosen {
         return t;
     }
@@ -117,12 +143,11 @@ fn tropism(tree: &mut Tree, heading: Vec3, order: u32, chosen: Option<Vec3>) -> 
     if s.upward_main_axis && order == 0 {
         return Vec3::Y;
     }
-    let theta = if order < s.scaffold_orders {
-        s.scaffold_gravitropism_angle_deg
+    let (sin_t, cos_t) = if order < s.scaffold_orders {
+        angles.scaffold_theta
     } else {
-        s.gravitropism_angle_deg
+        angles.theta
     };
-    let (sin_t, cos_t) = theta.to_radians().sin_cos();
     let horizontal = Vec3::new(heading.x, 0.0, heading.z)
         .try_normalize()
         .unwrap_or_else(|| {
@@ -136,6 +161,7 @@ fn tropism(tree: &mut Tree, heading: Vec3, order: u32, chosen: Option<Vec3>) -> 
 fn grow_shoot(
     tree: &mut Tree,
     scratch: &mut Scratch,
+    angles: &ShootAngles,
     bi: usize,
     n: u32,
     front: Option<&dyn Scene>,
@@ -174,7 +200,7 @@ fn grow_shoot(
             environment = e;
             carried = t.or(carried);
         }
-        let t = tropism(tree, heading, order, bud_override.or(carried));
+        let t = tropism(tree, angles, heading, order, bud_override.or(carried));
         // A stroke's direction (sketch tropism) weighs at least what the stroke asks for.
         let beta = match (bud_override, carried) {
             (None, Some(_)) => beta.max(tree.environment.attraction.sketch_tropism_weight),
@@ -206,7 +232,7 @@ fn grow_shoot(
             width_constraint: None,
             light_exposure: 0.0,
         };
-        buds::add_lateral_buds(&tree.species, &mut node, azimuth);
+        angles.lateral_buds.add_to(&mut node, azimuth);
         let id = NodeId(tree.skeleton.len() as u32);
         let parent_mut = &mut tree.skeleton.internodes[parent];
         if k == 0 && lateral {
