@@ -52,7 +52,7 @@ pub(crate) fn grow_all(
         _ => None,
     };
     let num_before = tree.skeleton.len();
-    let angles = ShootAngles::of(&tree.species);
+    let constants = ShootConstants::of(tree);
     let (mut shoots, mut added) = (0, 0);
     for (i, &gone) in removed.iter().enumerate().take(num_before) {
         if gone {
@@ -67,7 +67,7 @@ pub(crate) fn grow_all(
             }
             let n = shoot_length(bud.vigor, v_max, n_max);
             if n > 0 {
-                let grown = grow_shoot(tree, scratch, &angles, bi, n, front);
+                let grown = grow_shoot(tree, scratch, &constants, bi, n, front);
                 shoots += usize::from(grown > 0);
                 added += grown;
             }
@@ -107,8 +107,11 @@ fn deflect(
     }
 }
 
-/// The angles every shoot of an iteration grows by, their sines and cosines worked out once.
-struct ShootAngles {
+/// What every shoot of an iteration grows by, worked out once: the model's radii and the sines
+/// and cosines of its angles.
+struct ShootConstants {
+    /// Occupancy radius r, perception radius r + d (metres) and cos(ζ/2).
+    radii: (f32, f32, f32),
     /// sin and cos of the gravitropic set-point angle θ.
     theta: (f32, f32),
     /// sin and cos of the scaffold's set-point angle θ_s.
@@ -116,9 +119,11 @@ struct ShootAngles {
     lateral_buds: buds::LateralBudPlacement,
 }
 
-impl ShootAngles {
-    fn of(s: &crate::species::Species) -> Self {
-        ShootAngles {
+impl ShootConstants {
+    fn of(tree: &Tree) -> Self {
+        let s = &tree.species;
+        ShootConstants {
+            radii: space::radii(tree),
             theta: s.gravitropism_angle_deg.to_radians().sin_cos(),
             scaffold_theta: s.scaffold_gravitropism_angle_deg.to_radians().sin_cos(),
             lateral_buds: buds::LateralBudPlacement::of(s),
@@ -131,7 +136,7 @@ impl ShootAngles {
 /// the main axis of conifers).
 fn tropism(
     tree: &mut Tree,
-    angles: &ShootAngles,
+    constants: &ShootConstants,
     heading: Vec3,
     order: u32,
     chosen: Option<Vec3>,
@@ -144,9 +149,9 @@ fn tropism(
         return Vec3::Y;
     }
     let (sin_t, cos_t) = if order < s.scaffold_orders {
-        angles.scaffold_theta
+        constants.scaffold_theta
     } else {
-        angles.theta
+        constants.theta
     };
     let horizontal = Vec3::new(heading.x, 0.0, heading.z)
         .try_normalize()
@@ -161,13 +166,13 @@ fn tropism(
 fn grow_shoot(
     tree: &mut Tree,
     scratch: &mut Scratch,
-    angles: &ShootAngles,
+    constants: &ShootConstants,
     bi: usize,
     n: u32,
     front: Option<&dyn Scene>,
 ) -> usize {
     let bud = scratch.buds[bi];
-    let (r, _, _) = space::radii(tree);
+    let radii = constants.radii;
     let s = &tree.species;
     let (alpha, beta, gamma) = (s.straightness, s.tropism_weight, s.environment_weight);
     let l = s.internode_length_m;
@@ -200,7 +205,7 @@ fn grow_shoot(
             environment = e;
             carried = t.or(carried);
         }
-        let t = tropism(tree, angles, heading, order, bud_override.or(carried));
+        let t = tropism(tree, constants, heading, order, bud_override.or(carried));
         // A stroke's direction (sketch tropism) weighs at least what the stroke asks for.
         let beta = match (bud_override, carried) {
             (None, Some(_)) => beta.max(tree.environment.attraction.sketch_tropism_weight),
@@ -232,7 +237,7 @@ fn grow_shoot(
             width_constraint: None,
             light_exposure: 0.0,
         };
-        angles.lateral_buds.add_to(&mut node, azimuth);
+        constants.lateral_buds.add_to(&mut node, azimuth);
         let id = NodeId(tree.skeleton.len() as u32);
         let parent_mut = &mut tree.skeleton.internodes[parent];
         if k == 0 && lateral {
@@ -251,9 +256,9 @@ fn grow_shoot(
         node.light_exposure = tree.ambient_at(end) * tree.species.full_exposure;
         tree.skeleton.internodes.push(node);
         if k + 1 < n {
-            perceived = space::consume_and_perceive(tree, scratch, end, r, new_heading);
+            perceived = space::consume_and_perceive(tree, scratch, end, radii, new_heading);
         } else {
-            space::consume(scratch, end, r);
+            space::consume(scratch, end, radii.0);
         }
         heading = new_heading;
         parent = id.index();

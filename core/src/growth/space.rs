@@ -259,15 +259,14 @@ fn generate_points(tree: &mut Tree, scratch: &Scratch, r: f32, perception: f32, 
 /// [`consume`] at a new node's end (`tip`), then the optimal direction E (and carried
 /// tropism) that the next internode of its shoot perceives from there, heading along
 /// `heading`: in one scan of the perception sphere, the points visited in the order a separate
-/// consumption and perception would visit them.
+/// consumption and perception would visit them. `radii` are the model's ([`radii`]).
 pub(crate) fn consume_and_perceive(
     tree: &Tree,
     scratch: &mut Scratch,
     tip: Vec3,
-    r: f32,
+    (r, perception, cos_half): (f32, f32, f32),
     heading: Vec3,
 ) -> Option<(Vec3, Option<Vec3>)> {
-    let (_, perception, cos_half) = radii(tree);
     let consume_r2 = r * r;
     let points = &tree.environment.attraction.points;
     let mut sum = Vec3::ZERO;
