@@ -59,7 +59,7 @@ pub(crate) fn grow_all(
             continue;
         }
         let range = scratch.node_bud_start[i] as usize..scratch.node_bud_start[i + 1] as usize;
-        deflect(tree, scratch, i, range.clone(), v_max, n_max);
+        deflect(tree, scratch, &constants, i, range.clone(), v_max, n_max);
         for bi in range {
             let bud = scratch.buds[bi];
             if !bud.enabled {
@@ -80,13 +80,16 @@ pub(crate) fn grow_all(
 fn deflect(
     tree: &mut Tree,
     scratch: &mut Scratch,
+    constants: &ShootConstants,
     node: usize,
     range: std::ops::Range<usize>,
     v_max: f32,
     n_max: f32,
 ) {
-    let delta = tree.species.deflection_angle_deg.to_radians();
-    if delta <= 0.0 || range.is_empty() || scratch.buds[range.start].slot != TERMINAL {
+    let Some((sin_delta, cos_delta)) = constants.deflection else {
+        return;
+    };
+    if range.is_empty() || scratch.buds[range.start].slot != TERMINAL {
         return;
     }
     let h = scratch.buds[range.start].direction;
@@ -99,8 +102,9 @@ fn deflect(
     let Some(away) = away.try_normalize() else {
         return;
     };
-    let (s, c) = delta.sin_cos();
-    let deflected = (c * h - s * away).try_normalize().unwrap_or(h);
+    let deflected = (cos_delta * h - sin_delta * away)
+        .try_normalize()
+        .unwrap_or(h);
     scratch.buds[range.start].direction = deflected;
     if let Some(bud) = &mut tree.skeleton.internodes[node].terminal_bud {
         bud.direction = deflected;
@@ -117,6 +121,8 @@ struct ShootConstants {
     /// sin and cos of the scaffold's set-point angle θ_s.
     scaffold_theta: (f32, f32),
     lateral_buds: buds::LateralBudPlacement,
+    /// sin and cos of the deflection angle δ, if it is positive.
+    deflection: Option<(f32, f32)>,
 }
 
 impl ShootConstants {
@@ -127,6 +133,9 @@ impl ShootConstants {
             theta: s.gravitropism_angle_deg.to_radians().sin_cos(),
             scaffold_theta: s.scaffold_gravitropism_angle_deg.to_radians().sin_cos(),
             lateral_buds: buds::LateralBudPlacement::of(s),
+            deflection: Some(s.deflection_angle_deg.to_radians())
+                .filter(|&delta| delta > 0.0)
+                .map(f32::sin_cos),
         }
     }
 }
