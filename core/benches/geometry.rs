@@ -11,10 +11,13 @@
 //! call. Also the GLB encoding of the 10k tree.
 //!
 //! - `mesh_drawn_level_cpu`: the 100k drawn level reusing buffers again, measured in CPU time
-//!   of the benchmark thread (Linux `/proc/thread-self/schedstat`) instead of wall-clock time:
-//!   the one-core cost, without the time spent waiting for a core on a busy machine.
+//!   of the benchmark thread (`clock_gettime(CLOCK_THREAD_CPUTIME_ID)`) instead of wall-clock
+//!   time: the one-core cost, without the time spent waiting for a core on a busy machine.
 
 use std::hint::black_box;
+
+#[path = "common/thread_cpu.rs"]
+mod thread_cpu;
 
 use criterion::measurement::{Measurement, ValueFormatter, WallTime};
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
@@ -92,16 +95,13 @@ struct ThreadCpuTime;
 
 impl ThreadCpuTime {
     fn now_ns() -> u64 {
-        std::fs::read_to_string("/proc/thread-self/schedstat")
-            .ok()
-            .and_then(|text| text.split_whitespace().next()?.parse().ok())
-            .unwrap_or_else(|| {
-                static START: std::sync::OnceLock<std::time::Instant> = std::sync::OnceLock::new();
-                START
-                    .get_or_init(std::time::Instant::now)
-                    .elapsed()
-                    .as_nanos() as u64
-            })
+        thread_cpu::thread_cpu_ns().unwrap_or_else(|| {
+            static START: std::sync::OnceLock<std::time::Instant> = std::sync::OnceLock::new();
+            START
+                .get_or_init(std::time::Instant::now)
+                .elapsed()
+                .as_nanos() as u64
+        })
     }
 }
 

@@ -13,11 +13,9 @@ use std::time::Instant;
 mod growth_trees;
 use growth_trees::{brush_iteration, brush_points, grow_to_with, next_brush_tree};
 
-/// Nanoseconds this thread has run on a CPU; `None` off Linux.
-fn thread_cpu_ns() -> Option<u64> {
-    let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-    text.split_whitespace().next()?.parse().ok()
-}
+#[path = "../benches/common/thread_cpu.rs"]
+mod thread_cpu;
+use thread_cpu::thread_cpu_ns;
 
 fn cpu_ms(start: Option<u64>) -> f64 {
     match (start, thread_cpu_ns()) {

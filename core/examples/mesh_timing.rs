@@ -1,6 +1,6 @@
 //! Times meshing of a synthetic 100k-internode tree with leaves, in wall-clock and in CPU time
-//! of this thread (Linux `/proc/thread-self/schedstat`), so the one-core cost can be read on a
-//! busy machine where criterion's wall-clock figures include waiting for a core.
+//! of this thread (`clock_gettime(CLOCK_THREAD_CPUTIME_ID)`), so the one-core cost can be read
+//! on a busy machine where criterion's wall-clock figures include waiting for a core.
 //!
 //! Two builds: the drawn level of detail (level 0) with leaves and fruit, as the app re-meshes
 //! after an edit, and all three levels, as the glTF export does; each with fresh buffers and
@@ -29,11 +29,9 @@ use sylva_core::geometry::{
 use sylva_core::species::Species;
 use sylva_core::tree::Skeleton;
 
-/// Nanoseconds this thread has run on a CPU; `None` off Linux.
-fn thread_cpu_ns() -> Option<u64> {
-    let text = std::fs::read_to_string("/proc/thread-self/schedstat").ok()?;
-    text.split_whitespace().next()?.parse().ok()
-}
+#[path = "../benches/common/thread_cpu.rs"]
+mod thread_cpu;
+use thread_cpu::thread_cpu_ns;
 
 fn main() {
     let mut args = std::env::args().skip(1).peekable();
