@@ -22,6 +22,16 @@ fn baseline() -> Species {
     s
 }
 
+/// The baseline with laterals steered by gravitropism: set-point angle θ, an upward main axis
+/// and the direction weights (α, β, γ).
+fn gravitropic(theta_deg: f32, (alpha, beta, gamma): (f32, f32, f32)) -> Species {
+    let mut s = baseline();
+    s.gravitropism_angle_deg = theta_deg;
+    s.upward_main_axis = true;
+    (s.straightness, s.tropism_weight, s.environment_weight) = (alpha, beta, gamma);
+    s
+}
+
 fn grow(species: &Species, seed: u64) -> (Tree, IterationStats) {
     let mut tree = Tree::new(species.clone(), seed);
     let stats = tree.grow(ITERATIONS, None);
@@ -116,14 +126,7 @@ fn a_gravitropic_angle_of_90_degrees_makes_laterals_nearer_horizontal_than_0_deg
 
 #[test]
 fn an_ascending_scaffold_angle_raises_the_main_limbs_while_the_twigs_still_hang() {
-    let mut weeping = baseline();
-    weeping.gravitropism_angle_deg = 160.0;
-    weeping.upward_main_axis = true;
-    (
-        weeping.straightness,
-        weeping.tropism_weight,
-        weeping.environment_weight,
-    ) = (0.3, 0.4, 0.3);
+    let weeping = gravitropic(160.0, (0.3, 0.4, 0.3));
     let mut scaffold = weeping.clone();
     scaffold.scaffold_orders = 2;
     scaffold.scaffold_gravitropism_angle_deg = 30.0;
@@ -208,14 +211,7 @@ fn upper_side_fraction(tree: &Tree) -> f64 {
 
 #[test]
 fn shifting_the_gravimorphism_ellipse_up_makes_more_upper_side_laterals_grow() {
-    let mut down = baseline();
-    down.gravitropism_angle_deg = 90.0;
-    down.upward_main_axis = true;
-    (
-        down.straightness,
-        down.tropism_weight,
-        down.environment_weight,
-    ) = (0.4, 0.3, 0.3);
+    let mut down = gravitropic(90.0, (0.4, 0.3, 0.3));
     down.gravimorphism.vertical_offset = -0.7;
     let mut up = down.clone();
     up.gravimorphism.vertical_offset = 0.7;

@@ -82,6 +82,10 @@ fn for_each_pyramid_brick(
     }
 }
 
+/// A brick a shadow pyramid reaches, as [`ShadowGrid::apply_node`] plans it: brick index, brick
+/// coordinates and the levels q whose square lies partly in the brick.
+type PyramidBrick = (usize, IVec3, std::ops::RangeInclusive<i32>);
+
 /// The part of a pyramid level's square (half-width q around the node's column) inside one
 /// brick, in the brick's own columns x0..=x1 and rows z0..=z1.
 struct Square {
@@ -159,7 +163,7 @@ pub struct ShadowGrid {
     num_bricks: usize,
     /// Working memory of [`ShadowGrid::apply_node`]: the bricks a pyramid reaches (index,
     /// brick coordinates, levels in it).
-    reached: Vec<(usize, IVec3, std::ops::RangeInclusive<i32>)>,
+    reached: Vec<PyramidBrick>,
 }
 
 impl ShadowGrid {
@@ -251,7 +255,7 @@ impl ShadowGrid {
     fn plan_pyramid(
         &mut self,
         node_in_world: Vec3,
-        reached: &mut Vec<(usize, IVec3, std::ops::RangeInclusive<i32>)>,
+        reached: &mut Vec<PyramidBrick>,
     ) -> Option<IVec3> {
         reached.clear();
         if self.level_units.is_empty() || !node_in_world.is_finite() {
@@ -283,12 +287,7 @@ impl ShadowGrid {
 
     /// The second pass of [`ShadowGrid::apply_node`]: the row updates of the pyramid of a node
     /// in voxel `top` over the bricks `reached` that [`ShadowGrid::plan_pyramid`] found.
-    fn add_pyramid(
-        &mut self,
-        top: IVec3,
-        reached: &[(usize, IVec3, std::ops::RangeInclusive<i32>)],
-        sign: i32,
-    ) {
+    fn add_pyramid(&mut self, top: IVec3, reached: &[PyramidBrick], sign: i32) {
         for (brick, b, levels) in reached {
             let (units, layers) = self.brick_layers_mut(*brick);
             for q in levels.clone() {
