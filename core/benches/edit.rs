@@ -6,7 +6,7 @@ use std::hint::black_box;
 use criterion::{BatchSize, Criterion, criterion_group, criterion_main};
 use glam::Vec3;
 use sylva_core::edit::{
-    Bend, BendSettings, BrushPlane, BrushSettings, BrushStroke, PositionalConstraint,
+    Bend, BendSettings, BrushPlane, BrushSettings, BrushStroke, PositionalConstraint, StrokeCamera,
 };
 use sylva_core::growth::Tree;
 use sylva_core::species::Species;
@@ -105,15 +105,16 @@ fn brush(c: &mut Criterion) {
         .map(|n| n.end.y)
         .fold(0.0, f32::max);
     let plane = BrushPlane::new(Vec3::ZERO, Vec3::Z).expect("plane");
+    let camera = StrokeCamera::facing(plane, 5.0).expect("camera");
     c.bench_function("brush_iteration_20k_internodes", |b| {
         b.iter_batched(
             || {
-                let mut stroke = BrushStroke::new(plane, BrushSettings::default());
+                let mut stroke = BrushStroke::new(5.0, BrushSettings::default()).expect("stroke");
                 stroke
-                    .add_point(0.0, Vec3::new(-1.0, top, 0.0), 0.4)
+                    .add_point(0.0, camera, Vec3::new(-1.0, top, 0.0), 0.4)
                     .expect("point");
                 stroke
-                    .add_point(0.1, Vec3::new(1.0, top + 0.5, 0.0), 0.4)
+                    .add_point(0.1, camera, Vec3::new(1.0, top + 0.5, 0.0), 0.4)
                     .expect("point");
                 (tree.clone(), stroke)
             },

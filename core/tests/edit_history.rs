@@ -6,8 +6,8 @@ use glam::{Vec2, Vec3};
 use sylva_core::Rng;
 use sylva_core::edit::{
     Bend, BendSettings, BrushPlane, BrushSettings, BrushStroke, EditError, History, Lasso,
-    OperationKind, PositionalConstraint, Timeline, begin_selective_growth, end_selective_growth,
-    prune_at, set_width_constraint, skeleton_at_iteration,
+    OperationKind, PositionalConstraint, StrokeCamera, Timeline, begin_selective_growth,
+    end_selective_growth, prune_at, set_width_constraint, skeleton_at_iteration,
 };
 use sylva_core::growth::{StepOptions, Tree};
 use sylva_core::species::Species;
@@ -26,16 +26,18 @@ fn random_point_near(tree: &Tree, rng: &mut Rng) -> Vec3 {
 }
 
 fn stroke(tree: &mut Tree, rng: &mut Rng) -> Result<(), EditError> {
-    let plane = BrushPlane::new(Vec3::ZERO, Vec3::Z)?;
+    // A still camera 10 m in front of the plane z = 0.
+    let camera = StrokeCamera::facing(BrushPlane::new(Vec3::ZERO, Vec3::Z)?, 10.0)?;
     let settings = BrushSettings {
         sketch_tropism: rng.below(2) == 1,
         ..BrushSettings::default()
     };
-    let mut stroke = BrushStroke::new(plane, settings);
+    let mut stroke = BrushStroke::new(10.0, settings)?;
     let start = random_point_near(tree, rng);
-    stroke.add_point(0.0, start, rng.range_f32(0.0, 0.5))?;
+    stroke.add_point(0.0, camera, start, rng.range_f32(0.0, 0.5))?;
     stroke.add_point(
         0.2,
+        camera,
         start + rng.in_unit_ball() * 0.6,
         rng.range_f32(0.0, 0.5),
     )?;
@@ -71,7 +73,7 @@ fn lasso(tree: &mut Tree, rng: &mut Rng) -> Result<(), EditError> {
         .map(|i| Vec2::from_angle(i as f32 / 24.0 * std::f32::consts::TAU) * 0.4)
         .collect();
     let lasso = Lasso::new(centre, Vec3::X, Vec3::Y, outline)?;
-    lasso.envelope(32).add_points_to(tree, 60, None);
+    lasso.envelope(32).add_points_to(tree, 60);
     tree.step(StepOptions {
         autonomous: false,
         scene: None,

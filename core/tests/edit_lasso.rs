@@ -1,8 +1,10 @@
 //! Done-when item 4 of issue 3: a lasso of a circle grows a crown whose silhouette on the lasso
-//! plane stays inside the circle enlarged by one internode length.
+//! plane stays inside the circle enlarged by one internode length; and the tree's depth
+//! constraint (issue 20) holds for lassoed points.
 
 use glam::{Vec2, Vec3};
 use sylva_core::edit::Lasso;
+use sylva_core::environment::DepthConstraint;
 use sylva_core::growth::{StepOptions, Tree};
 use sylva_core::species::Species;
 
@@ -18,7 +20,7 @@ fn a_circular_lasso_grows_a_crown_inside_the_circle() {
         .collect();
     let lasso = Lasso::new(Vec3::ZERO, Vec3::X, Vec3::Y, outline).expect("valid lasso");
     let envelope = lasso.envelope(96);
-    let added = envelope.add_points_to(&mut tree, 1500, None);
+    let added = envelope.add_points_to(&mut tree, 1500);
     assert_eq!(added, 1500);
     for _ in 0..30 {
         let stats = tree.step(StepOptions {
@@ -56,4 +58,30 @@ fn a_circular_lasso_grows_a_crown_inside_the_circle() {
     );
     // Teddy inflation: the crown is round in depth too, not flat.
     assert!(depth > 0.5 * radius, "crown depth only {depth} m");
+}
+
+#[test]
+fn a_lasso_adds_no_point_outside_the_depth_constraint() {
+    let species = Species::by_name("maple").expect("maple preset");
+    let outline: Vec<Vec2> = (0..48)
+        .map(|i| Vec2::new(0.0, 1.1) + Vec2::from_angle(i as f32 / 48.0 * std::f32::consts::TAU))
+        .collect();
+    let lasso = Lasso::new(Vec3::ZERO, Vec3::X, Vec3::Y, outline).expect("valid lasso");
+    let envelope = lasso.envelope(64);
+    let mut free = Tree::new(species.clone(), 7);
+    let free_added = envelope.add_points_to(&mut free, 1000);
+    let mut flat = Tree::new(species, 7);
+    let slab = DepthConstraint::new(Vec3::Z, 0.2).expect("valid constraint");
+    flat.environment.set_depth_constraint(Some(slab));
+    let flat_added = envelope.add_points_to(&mut flat, 1000);
+    let points = &flat.environment.attraction.points;
+    println!("lasso: {free_added} points free, {flat_added} within 0.2 m of the plane");
+    assert_eq!(free_added, 1000);
+    assert_eq!(points.len(), flat_added);
+    assert!(points.iter().all(|p| p.position.z.abs() <= 0.2));
+    // A ball-like envelope of radius 1 m: about a third of its volume lies within 0.2 m.
+    assert!(
+        (150..600).contains(&flat_added),
+        "{flat_added} of 1000 points within the slab"
+    );
 }

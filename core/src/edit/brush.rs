@@ -1,15 +1,24 @@
-//! Brushing and sketching (Longay 2014 §5.2.1, §5.2.3, §5.2.4, appendix B).
+//! Brushing and sketching (Longay 2014 §5.2.1, §5.2.3, §5.2.4, §5.4.2, appendix B).
 //!
-//! A brush is a sphere of radius ρ that moves along a stroke on a brush plane given by the
-//! caller (by default the plane through the tree's base parallel to the screen). While growth
-//! iterations run, the stroke continually adds uniformly random persistent attraction points in
-//! the volume swept since the last iteration; ρ may change from one stroke point to the next. As
-//! ρ → 0 the points lie on the stroke itself and brushing becomes sketching: the single axis
-//! that eats them follows the stroke.
+//! A brush is a sphere of radius ρ that moves along a stroke on a camera-facing brush plane. The
+//! stroke keeps one scene depth between the camera and its plane (§5.4.2: "a constant scene
+//! depth is maintained between the camera and the plane of the brush"): every stroke point comes
+//! with the camera it was drawn from ([`StrokeCamera`]: eye and view direction) and a point on
+//! the ray through the finger, and is placed where that ray meets the plane at the stroke's depth
+//! in front of *that* camera. Moving the device forward while painting moves the brush forward;
+//! a still camera draws on one fixed plane ([`StrokeCamera::facing`] gives the camera that sees
+//! a given plane at a given depth).
+//!
+//! While growth iterations run, the stroke continually adds uniformly random persistent
+//! attraction points in the volume swept between consecutive stroke points since the last
+//! iteration; ρ may change from one stroke point to the next. As ρ → 0 the points lie on the
+//! stroke itself and brushing becomes sketching: the single axis that eats them follows the
+//! stroke.
 //!
 //! Options: sketch-based tropism (each point carries the stroke direction, which becomes the
-//! tropism T of the bud it feeds), selective growth (only the branch from a picked bud may
-//! grow), and a depth constraint (points only within a depth of a plane through the base).
+//! tropism T of the bud it feeds) and selective growth (only the branch from a picked bud may
+//! grow). The tree's depth constraint ([`crate::environment::DepthConstraint`], appendix B)
+//! holds for brushed points too: the brush adds none outside it.
 
 use glam::Vec3;
 
@@ -18,7 +27,7 @@ use super::prune::distance_to_segment;
 use crate::growth::{IterationStats, StepOptions, Tree};
 use crate::tree::NodeId;
 
-/// The plane strokes are drawn on: a point and a unit normal (world space).
+/// A plane: a point and a unit normal (world space).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct BrushPlane {
     pub origin: Vec3,
@@ -43,13 +52,70 @@ impl BrushPlane {
     }
 }
 
-/// A sample of the stroke: when, where (projected on the brush plane) and how wide.
+/// The camera a stroke point is drawn from: its eye and unit view direction (the optical axis),
+/// world space. Depths are measured along the view direction, as camera-space Z.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct StrokeCamera {
+    eye: Vec3,
+    view_direction: Vec3,
+}
+
+impl StrokeCamera {
+    /// The camera at `eye` looking along `view_direction` (normalised; an error if zero or not
+    /// finite).
+    pub fn new(eye: Vec3, view_direction: Vec3) -> Result<StrokeCamera, EditError> {
+        let view_direction = view_direction
+            .try_normalize()
+            .filter(|_| eye.is_finite())
+            .ok_or(EditError::NonFinite {
+                what: "stroke camera",
+            })?;
+        Ok(StrokeCamera {
+            eye,
+            view_direction,
+        })
+    }
+
+    /// The still camera `depth_m` in front of `plane`, looking at it against its normal: a
+    /// stroke of that depth drawn from it lies on the plane (the fixed brush plane).
+    pub fn facing(plane: BrushPlane, depth_m: f32) -> Result<StrokeCamera, EditError> {
+        StrokeCamera::new(plane.origin + plane.normal * depth_m, -plane.normal)
+    }
+
+    pub fn eye(&self) -> Vec3 {
+        self.eye
+    }
+
+    pub fn view_direction(&self) -> Vec3 {
+        self.view_direction
+    }
+
+    /// The brush plane `depth_m` in front of the camera (normal towards the camera).
+    pub fn plane_at(&self, depth_m: f32) -> BrushPlane {
+        BrushPlane {
+            origin: self.eye + self.view_direction * depth_m,
+            normal: -self.view_direction,
+        }
+    }
+
+    /// Where the ray from the eye through `through` meets the brush plane `depth_m` in front of
+    /// the camera; None when `through` is not in front of the camera.
+    pub fn point_at_depth(&self, through: Vec3, depth_m: f32) -> Option<Vec3> {
+        let ray = through - self.eye;
+        let along = ray.dot(self.view_direction);
+        (along > 1e-6 && along.is_finite()).then(|| self.eye + ray * (depth_m / along))
+    }
+}
+
+/// A sample of the stroke: when, where (on the brush plane of its camera), how wide, and the
+/// camera it was drawn from.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct StrokePoint {
     pub time_s: f64,
     pub position: Vec3,
     /// Brush radius ρ (metres); 0 sketches.
     pub radius_m: f32,
+    pub camera: StrokeCamera,
 }
 
 /// Knobs of a stroke.
@@ -64,8 +130,6 @@ pub struct BrushSettings {
     /// With sketch tropism, the least weight β of the stroke direction for the buds it feeds
     /// (see [`crate::environment::AttractionPoints::sketch_tropism_weight`]).
     pub sketch_tropism_weight: f32,
-    /// Depth constraint: keep only points within this distance of the brush plane (metres).
-    pub depth_limit_m: Option<f32>,
 }
 
 /// Default least weight of the stroke direction under sketch tropism.
@@ -78,7 +142,6 @@ impl Default for BrushSettings {
             points_per_internode_cube: 0.5,
             sketch_tropism: false,
             sketch_tropism_weight: SKETCH_TROPISM_WEIGHT,
-            depth_limit_m: None,
         }
     }
 }
@@ -86,7 +149,8 @@ impl Default for BrushSettings {
 /// One stroke in progress.
 #[derive(Clone, Debug)]
 pub struct BrushStroke {
-    plane: BrushPlane,
+    /// Scene depth of the brush plane in front of each point's camera (metres).
+    depth_m: f32,
     settings: BrushSettings,
     points: Vec<StrokePoint>,
     /// Stroke points already turned into attraction points (segments before this index).
@@ -94,32 +158,43 @@ pub struct BrushStroke {
 }
 
 impl BrushStroke {
-    pub fn new(plane: BrushPlane, settings: BrushSettings) -> BrushStroke {
-        BrushStroke {
-            plane,
+    /// A stroke whose brush plane stays `depth_m` in front of the camera (positive, finite).
+    pub fn new(depth_m: f32, settings: BrushSettings) -> Result<BrushStroke, EditError> {
+        if !(depth_m.is_finite() && depth_m > 0.0) {
+            return Err(EditError::BadParameter {
+                name: "brush plane depth (m)",
+                value: depth_m,
+            });
+        }
+        Ok(BrushStroke {
+            depth_m,
             settings,
             points: Vec::new(),
             emitted: 0,
-        }
+        })
     }
 
     pub fn points(&self) -> &[StrokePoint] {
         &self.points
     }
 
-    pub fn plane(&self) -> BrushPlane {
-        self.plane
+    /// Scene depth of the brush plane in front of the camera (metres).
+    pub fn depth_m(&self) -> f32 {
+        self.depth_m
     }
 
-    /// Adds a stroke sample; the position is projected on the brush plane. Times must not go
-    /// back and the radius must be finite and non-negative.
+    /// Adds a stroke sample drawn from `camera`: `through` is any world point on the ray
+    /// through the finger, and the sample is placed where that ray meets the plane at the
+    /// stroke's depth in front of the camera. Returns the placed point. Times must not go back,
+    /// the radius must be finite and non-negative and `through` in front of the camera.
     pub fn add_point(
         &mut self,
         time_s: f64,
-        position: Vec3,
+        camera: StrokeCamera,
+        through: Vec3,
         radius_m: f32,
-    ) -> Result<(), EditError> {
-        if !(position.is_finite() && time_s.is_finite()) {
+    ) -> Result<Vec3, EditError> {
+        if !(through.is_finite() && time_s.is_finite()) {
             return Err(EditError::NonFinite {
                 what: "stroke point",
             });
@@ -138,12 +213,20 @@ impl BrushStroke {
                 value: time_s as f32,
             });
         }
+        let position =
+            camera
+                .point_at_depth(through, self.depth_m)
+                .ok_or(EditError::BadParameter {
+                    name: "stroke point depth in front of the camera (m)",
+                    value: (through - camera.eye).dot(camera.view_direction),
+                })?;
         self.points.push(StrokePoint {
             time_s,
-            position: self.plane.project(position),
+            position,
             radius_m,
+            camera,
         });
-        Ok(())
+        Ok(position)
     }
 
     /// Turns the part of the stroke drawn since the last call into persistent attraction
@@ -200,9 +283,7 @@ impl BrushStroke {
             let centre = a.position.lerp(b.position, t);
             let rho = a.radius_m + (b.radius_m - a.radius_m) * t;
             let p = centre + tree.rng.in_unit_ball() * rho;
-            if let Some(depth) = self.settings.depth_limit_m
-                && (p - self.plane.origin).dot(self.plane.normal).abs() > depth
-            {
+            if !tree.environment.depth_allows(p) {
                 continue;
             }
             match direction.filter(|_| self.settings.sketch_tropism) {
@@ -229,23 +310,6 @@ impl BrushStroke {
                 .fold(f32::INFINITY, f32::min),
         }
     }
-}
-
-/// Depth constraint (appendix B): removes attraction points farther than `depth_m` from the
-/// plane through the tree's base with normal `normal`. Returns how many were removed.
-pub fn apply_depth_constraint(tree: &mut Tree, normal: Vec3, depth_m: f32) -> usize {
-    let Some(normal) = normal.try_normalize() else {
-        return 0;
-    };
-    let base = tree
-        .skeleton
-        .internodes
-        .first()
-        .map_or(Vec3::ZERO, |n| n.start);
-    let points = &mut tree.environment.attraction.points;
-    let before = points.len();
-    points.retain(|p| (p.position - base).dot(normal).abs() <= depth_m);
-    before - points.len()
 }
 
 /// Selective growth (§5.2.4): the living bud nearest `pick` is re-oriented along the stroke's

@@ -166,18 +166,13 @@ impl LassoEnvelope {
     }
 
     /// Fills the envelope with `count` persistent attraction points of `tree` (drawn from the
-    /// tree's generator), optionally only within `depth_limit_m` of the lasso plane (the depth
-    /// constraint). Returns how many were added.
-    pub fn add_points_to(
-        &self,
-        tree: &mut Tree,
-        count: usize,
-        depth_limit_m: Option<f32>,
-    ) -> usize {
+    /// tree's generator), leaving out those the tree's depth constraint refuses
+    /// ([`crate::environment::DepthConstraint`]). Returns how many were added.
+    pub fn add_points_to(&self, tree: &mut Tree, count: usize) -> usize {
         let points = self.sample_points(count, &mut tree.rng);
         let mut added = 0;
         for p in points {
-            if depth_limit_m.is_some_and(|d| self.plane_from_world(p).1.abs() > d) {
+            if !tree.environment.depth_allows(p) {
                 continue;
             }
             tree.environment.attraction.add_persistent(p);

@@ -1,10 +1,12 @@
 //! Modelling operations (Longay 2014 §5.2–5.3, appendices A and B), independent of any UI so that
 //! the app, replayed sessions and tests drive the same code.
 //!
-//! One concept per module: [`brush`] (brushing, sketching, sketch tropism, selective growth,
-//! depth constraint), [`lasso`] (silhouette → chordal axis → envelope → attraction points),
+//! One concept per module: [`brush`] (brushing and sketching on a brush plane that follows the
+//! device, sketch tropism, selective growth), [`lasso`] (silhouette → chordal axis → envelope → attraction points),
 //! [`prune`], [`bend`] (PriMo on skeletons), [`widths`] (width constraints), [`history`]
-//! (operation-level undo/redo and ungrow/regrow).
+//! (operation-level undo/redo and ungrow/regrow). The depth constraint is one slab kept by the
+//! tree's environment ([`crate::environment::DepthConstraint`]); brush and lasso add no point
+//! outside it.
 //!
 //! Space: world metres, Y up, origin on the ground at the tree's base.
 
@@ -19,8 +21,8 @@ pub mod widths;
 
 pub use bend::{Bend, BendPose, BendSettings, PositionalConstraint};
 pub use brush::{
-    BrushPlane, BrushSettings, BrushStroke, StrokePoint, apply_depth_constraint,
-    begin_selective_growth, end_selective_growth,
+    BrushPlane, BrushSettings, BrushStroke, StrokeCamera, StrokePoint, begin_selective_growth,
+    end_selective_growth,
 };
 pub use history::{History, OperationKind, Timeline, skeleton_at_iteration};
 pub use lasso::{Lasso, LassoEnvelope};

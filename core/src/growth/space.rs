@@ -55,11 +55,10 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
             .points
             .retain(|p| p.position.y >= ground_y);
     }
+    // The depth constraint: brushed and lassoed points never enter outside it, generated ones
+    // (and any from before it was set) leave here.
     if let Some(constraint) = tree.environment.depth_constraint {
-        tree.environment
-            .attraction
-            .points
-            .retain(|p| constraint.allows(p.position));
+        constraint.retain_allowed(&mut tree.environment.attraction);
     }
     if let Some((scene, SceneMode::GrowInFront)) = options.scene {
         tree.environment
