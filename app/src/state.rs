@@ -7,15 +7,16 @@
 //! **The brush plane** faces the camera at the depth where the stroke started (a branch's depth
 //! when the stroke starts on a branch, else the tree's) and keeps that camera distance while
 //! painting: each new frame re-projects the finger through the *current* camera, so moving the
-//! device moves the plane and lengthens the stroke.
+//! device moves the plane and lengthens the stroke. The core stroke gets the same camera with
+//! each point, so the attraction points (what the tree grows towards) move with it too.
 
 use std::collections::BTreeMap;
 
 use glam::{Quat, Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 use sylva_core::edit::{
-    Bend, BendSettings, BrushPlane, BrushSettings, BrushStroke, History, OperationKind,
-    PositionalConstraint, Timeline, prune_at,
+    Bend, BendSettings, BrushSettings, BrushStroke, History, OperationKind, PositionalConstraint,
+    StrokeCamera, Timeline, prune_at,
 };
 use sylva_core::species::Species;
 use sylva_core::{NodeId, Tree};
@@ -523,7 +524,9 @@ impl DesignState {
     }
 
     /// Adds the finger's point on the brush plane seen from the current camera; the first
-    /// point starts an undoable `sylva_core` brush stroke on the plane facing the camera.
+    /// point starts an undoable `sylva_core` brush stroke at the stroke's camera depth, and
+    /// every point goes to it with the camera it was drawn from, so the attraction points
+    /// follow the device (Longay 2014 §5.4.2).
     fn add_stroke_point(&mut self) {
         let (Some(camera), Some(stroke)) = (self.camera, self.stroke.as_mut()) else {
             return;
@@ -538,25 +541,31 @@ impl DesignState {
             // Not yet a stroke: maybe a tap.
             return;
         }
-        let ray = camera.intrinsics.ray_from_pixel(stroke.pixel);
-        let point = camera
+        // A point on the ray through the finger (camera depth 1) and the camera's optical axis.
+        let through = camera
             .world_from_camera
-            .transform_point3(ray * stroke.depth);
+            .transform_point3(camera.intrinsics.ray_from_pixel(stroke.pixel));
+        let view_direction = camera.world_from_camera.transform_vector3(Vec3::Z);
+        let Ok(view) = StrokeCamera::new(camera.position(), view_direction) else {
+            return;
+        };
+        let Some(point) = view.point_at_depth(through, stroke.depth) else {
+            return;
+        };
         let radius = self.params.brush_radius;
         stroke.points.push(point);
         stroke.radii.push(radius);
         stroke.eyes.push(camera.position());
         if self.brush.is_none() {
-            let facing = camera.position() - point;
-            let Ok(plane) = BrushPlane::new(point, facing) else {
-                return;
-            };
-            self.history.record(OperationKind::Stroke, &self.tree);
             let settings = BrushSettings {
                 sketch_tropism: self.params.sketch_tropism,
                 ..BrushSettings::default()
             };
-            self.brush = Some(BrushStroke::new(plane, settings));
+            let Ok(brush) = BrushStroke::new(stroke.depth, settings) else {
+                return;
+            };
+            self.history.record(OperationKind::Stroke, &self.tree);
+            self.brush = Some(brush);
         }
         let time_s = self.time_s;
         if let Some(brush) = self.brush.as_mut() {
@@ -564,7 +573,7 @@ impl DesignState {
                 .points()
                 .last()
                 .map_or(time_s, |p| p.time_s.max(time_s));
-            if brush.add_point(time_s, point, radius).is_ok() {
+            if brush.add_point(time_s, view, through, radius).is_ok() {
                 brush.emit(&mut self.tree);
             }
         }

@@ -1,6 +1,7 @@
-//! The brush plane follows the device (Longay 2014 §5.2): while a finger is held still and the
-//! camera moves forward, the stroke's new world points move with the camera and stay at the
-//! stroke's starting camera distance. Frames are fed exactly as `sylva replay` feeds them.
+//! The brush plane follows the device (Longay 2014 §5.2, §5.4.2): while a finger is held still
+//! and the camera moves forward, the stroke's new world points move with the camera and stay at
+//! the stroke's starting camera distance, and so do the attraction points the core stroke adds
+//! (what the tree grows towards). Frames are fed exactly as `sylva replay` feeds them.
 
 use glam::{Mat4, Vec2, Vec3};
 use sylva_app::render::{Intrinsics, ViewCamera};
@@ -17,7 +18,12 @@ fn stroke_points_move_with_a_forward_moving_camera_at_constant_distance() {
             Mat4::from_translation(forward * 0.03 * i as f32) * start.world_from_camera;
         c
     };
-    let mut design = DesignState::new(3, Parameters::default());
+    // No growth while painting, so that every brushed attraction point stays to be checked.
+    let params = Parameters {
+        grow_speed: 0.0,
+        ..Parameters::default()
+    };
+    let mut design = DesignState::new(3, params);
     design.advance_frame(Some(camera_at(0)), 0.0, 1.0 / 30.0);
     let finger = Vec2::new(380.0, 150.0);
     design.apply(&InputEvent::Touch {
@@ -78,5 +84,56 @@ fn stroke_points_move_with_a_forward_moving_camera_at_constant_distance() {
         total.length() > 0.5,
         "the stroke lengthened by {} m",
         total.length()
+    );
+    // What the tree grows towards follows too: every brushed attraction point lies in the
+    // volume swept by the brush along the moving stroke, and the last ones around its end.
+    let radius = Parameters::default().brush_radius;
+    let polyline_distance = |p: Vec3| {
+        stroke
+            .points
+            .windows(2)
+            .map(|w| {
+                let d = w[1] - w[0];
+                let t = ((p - w[0]).dot(d) / d.length_squared().max(1e-12)).clamp(0.0, 1.0);
+                p.distance(w[0] + d * t)
+            })
+            .fold(f32::INFINITY, f32::min)
+    };
+    let attraction = &design.tree.environment.attraction.points;
+    let brushed: Vec<Vec3> = attraction
+        .iter()
+        .filter(|p| p.persistent)
+        .map(|p| p.position)
+        .collect();
+    assert!(brushed.len() > 20, "only {} brushed points", brushed.len());
+    let farthest = brushed
+        .iter()
+        .map(|&p| polyline_distance(p))
+        .fold(0.0, f32::max);
+    assert!(
+        farthest <= radius + 1e-4,
+        "a brushed point lies {farthest} m from the moving stroke (brush radius {radius})"
+    );
+    let end = frame_points[19];
+    let near_end = brushed
+        .iter()
+        .filter(|p| p.distance(end) <= radius + 1e-4)
+        .count();
+    assert!(
+        near_end > 0,
+        "no attraction point around the stroke's end {end}"
+    );
+    let first = frame_points[0];
+    let reach = brushed
+        .iter()
+        .map(|p| (*p - first).dot(forward))
+        .fold(f32::NEG_INFINITY, f32::max);
+    println!(
+        "{} brushed points, all within {farthest:.3} m of the stroke; {near_end} around its end, reaching {reach:.2} m forward of the first frame's point",
+        brushed.len()
+    );
+    assert!(
+        reach > 0.5,
+        "the attraction points reach only {reach} m forward"
     );
 }
