@@ -1,5 +1,6 @@
 //! UI tests driven by widget labels (egui_kittest): the α/β/γ triangle, the brush-radius slider
-//! mid-stroke, and undo.
+//! mid-stroke, undo, and the plain-language controls (issue 20), each changing the grown tree as
+//! its label says.
 
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
@@ -7,6 +8,7 @@ use glam::Vec3;
 use sylva_app::render::{Intrinsics, ViewCamera};
 use sylva_app::state::{DesignState, InputEvent, Parameters, TouchPhase};
 use sylva_app::ui::{UiState, sylva_ui};
+use sylva_core::Tree;
 
 struct App {
     ui: UiState,
@@ -72,7 +74,7 @@ fn brush_stroke(design: &mut DesignState) {
 #[test]
 fn dragging_the_weights_triangle_keeps_the_sum_one_and_changes_growth() {
     let mut h = harness(app());
-    h.get_by_label("Architecture").click();
+    h.get_by_label("Advanced").click();
     h.run();
     let rect = h.get_by_label("α β γ triangle").rect();
     let before = h.state().design.params.direction_weights;
@@ -173,4 +175,138 @@ fn undo_restores_the_previous_tree() {
     h.get_by_label("Undo").click();
     h.run();
     assert_eq!(h.state().design.tree.skeleton, before);
+}
+
+/// Age the plain-control tests grow their trees to, years.
+const CONTROL_AGE_YEARS: f64 = 10.0;
+
+/// Opens the "Tree" tab, lets `control` drive one plain control by its label, then grows the
+/// tree to [`CONTROL_AGE_YEARS`] with the age slider. Returns the grown tree.
+fn grown_after(control: impl FnOnce(&mut Harness<'static, App>)) -> Tree {
+    let mut h = harness(app());
+    h.get_by_label("Tree").click();
+    h.run();
+    control(&mut h);
+    h.run();
+    h.get_by_role_and_label(egui::Role::Slider, "Age (years)")
+        .set_value_accesskit(CONTROL_AGE_YEARS);
+    h.run();
+    let tree = h.state().design.tree.clone();
+    assert!(
+        tree.age_years() >= CONTROL_AGE_YEARS as f32 - 0.5,
+        "the age slider grew the tree only to {} years",
+        tree.age_years()
+    );
+    tree
+}
+
+fn slide(label: &'static str, value: f64) -> impl FnOnce(&mut Harness<'static, App>) {
+    move |h| {
+        h.get_by_role_and_label(egui::Role::Slider, label)
+            .set_value_accesskit(value)
+    }
+}
+
+fn mean(values: impl Iterator<Item = f32>) -> f32 {
+    let (sum, n) = values.fold((0.0, 0usize), |(s, n), v| (s + v, n + 1));
+    sum / n.max(1) as f32
+}
+
+/// Mean elevation of the branches (order ≥ 1) above the horizontal, degrees.
+fn mean_branch_elevation_deg(tree: &Tree) -> f32 {
+    mean(
+        tree.skeleton
+            .internodes
+            .iter()
+            .filter(|n| n.order >= 1)
+            .map(|n| n.heading().y.clamp(-1.0, 1.0).asin().to_degrees()),
+    )
+}
+
+/// Mean angle between each branch's first internode and the axis it grows from, degrees.
+fn mean_branching_angle_deg(tree: &Tree) -> f32 {
+    let nodes = &tree.skeleton.internodes;
+    mean(nodes.iter().filter_map(|n| {
+        let parent = &nodes[n.parent?.index()];
+        (n.order > parent.order).then(|| n.heading().angle_between(parent.heading()).to_degrees())
+    }))
+}
+
+/// Mean turn between consecutive internodes of one axis, degrees.
+fn mean_turn_along_axes_deg(tree: &Tree) -> f32 {
+    let nodes = &tree.skeleton.internodes;
+    mean(nodes.iter().filter_map(|n| {
+        let parent = &nodes[n.parent?.index()];
+        (n.order == parent.order).then(|| n.heading().angle_between(parent.heading()).to_degrees())
+    }))
+}
+
+#[test]
+fn weeping_lowers_the_branches_and_upright_raises_them() {
+    let click =
+        |label: &'static str| move |h: &mut Harness<'static, App>| h.get_by_label(label).click();
+    let weeping = mean_branch_elevation_deg(&grown_after(click("Weeping")));
+    let spreading = mean_branch_elevation_deg(&grown_after(click("Spreading")));
+    let upright = mean_branch_elevation_deg(&grown_after(click("Upright")));
+    println!(
+        "mean branch elevation: upright {upright:.1}°, spreading {spreading:.1}°, weeping {weeping:.1}°"
+    );
+    assert!(
+        weeping + 5.0 < spreading && spreading + 5.0 < upright,
+        "upright {upright}°, spreading {spreading}°, weeping {weeping}°"
+    );
+    let slid = mean_branch_elevation_deg(&grown_after(slide("Crown: upright to weeping", 1.0)));
+    assert!(
+        (slid - weeping).abs() < 1e-3,
+        "the slider's weeping end gives {slid}°"
+    );
+}
+
+#[test]
+fn a_denser_crown_keeps_more_branches() {
+    let sparse = grown_after(slide("Density", 0.0)).skeleton.len();
+    let dense = grown_after(slide("Density", 1.0)).skeleton.len();
+    println!("density 0: {sparse} internodes, density 1: {dense}");
+    assert!(
+        dense as f32 > 1.2 * sparse as f32,
+        "sparse {sparse}, dense {dense}"
+    );
+}
+
+#[test]
+fn a_wider_branch_angle_opens_the_branches_from_their_axis() {
+    let narrow = mean_branching_angle_deg(&grown_after(slide("Branch angle (°)", 20.0)));
+    let wide = mean_branching_angle_deg(&grown_after(slide("Branch angle (°)", 70.0)));
+    println!("branch angle 20°: branches leave at {narrow:.1}°, 70°: {wide:.1}°");
+    assert!(wide > narrow + 15.0, "narrow {narrow}°, wide {wide}°");
+}
+
+#[test]
+fn more_vigour_grows_a_bigger_tree() {
+    let height = |t: &Tree| {
+        t.skeleton
+            .internodes
+            .iter()
+            .map(|n| n.end.y)
+            .fold(0.0, f32::max)
+    };
+    let weak = grown_after(slide("Vigour", 0.1));
+    let strong = grown_after(slide("Vigour", 0.9));
+    println!(
+        "vigour 0.1: {} internodes, {:.2} m tall; 0.9: {} internodes, {:.2} m",
+        weak.skeleton.len(),
+        height(&weak),
+        strong.skeleton.len(),
+        height(&strong)
+    );
+    assert!(strong.skeleton.len() > 2 * weak.skeleton.len());
+    assert!(height(&strong) > height(&weak));
+}
+
+#[test]
+fn a_straighter_tree_turns_less_along_its_axes() {
+    let wavy = mean_turn_along_axes_deg(&grown_after(slide("Straightness", 0.1)));
+    let straight = mean_turn_along_axes_deg(&grown_after(slide("Straightness", 0.9)));
+    println!("mean turn along axes: straightness 0.1 {wavy:.1}°, 0.9 {straight:.1}°");
+    assert!(straight + 3.0 < wavy, "straight {straight}°, wavy {wavy}°");
 }

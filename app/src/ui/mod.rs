@@ -1,11 +1,13 @@
 //! The egui UI, touch first (mouse acts as touch): a side bar with brush radius, grow/ungrow and
-//! undo; a top bar with tabs (architecture, growth, species, years, export); the coaching overlay
-//! until the ground is found; the frame-budget overlay; play/pause/seek.
+//! undo; a top bar with tabs (the tree: species, age and plain-language crown controls; the
+//! research parameters under "Advanced"; export); the coaching overlay until the ground is found;
+//! the frame-budget overlay; play/pause/seek.
 //!
 //! UI functions never change the design directly: they emit [`InputEvent`]s, which the caller
 //! applies and records, so sessions capture every edit.
 
 pub mod orbit;
+pub mod plain;
 pub mod touch;
 pub mod widgets;
 
@@ -16,10 +18,10 @@ use crate::state::{DesignState, InputEvent};
 /// Top-bar tabs.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum Tab {
-    Architecture,
-    Growth,
-    Species,
-    Years,
+    /// Species, age in years and the plain-language controls ([`plain::tree_ui`]).
+    Tree,
+    /// The research parameters with their symbols ([`plain::advanced_ui`]).
+    Advanced,
     Export,
 }
 
@@ -84,10 +86,8 @@ pub fn sylva_ui(
     egui::Panel::top("sylva top bar").show(ui, |ui| {
         ui.horizontal(|ui| {
             for (tab, name) in [
-                (Tab::Architecture, "Architecture"),
-                (Tab::Growth, "Growth"),
-                (Tab::Species, "Species"),
-                (Tab::Years, "Years"),
+                (Tab::Tree, "Tree"),
+                (Tab::Advanced, "Advanced"),
                 (Tab::Export, "Export"),
             ] {
                 // Tapping the open tab closes it.
@@ -104,23 +104,8 @@ pub fn sylva_ui(
             return;
         };
         match tab {
-            Tab::Architecture => architecture_ui(ui, &mut params),
-            Tab::Growth => growth_ui(ui, &mut params),
-            Tab::Species => {
-                egui::ComboBox::from_label("Species")
-                    .selected_text(params.species.clone())
-                    .show_ui(ui, |ui| {
-                        for name in &state.species_names {
-                            ui.selectable_value(&mut params.species, name.clone(), name);
-                        }
-                    });
-            }
-            Tab::Years => {
-                ui.add(
-                    egui::Slider::new(&mut params.years, 1.0..=40.0)
-                        .text("Age (years): grows or ungrows the tree"),
-                );
-            }
+            Tab::Tree => plain::tree_ui(ui, &mut params, &state.species_names),
+            Tab::Advanced => plain::advanced_ui(ui, &mut params),
             Tab::Export => {
                 if ui.button("Export tree (.glb, .json)").clicked() {
                     state.export_requested = true;
@@ -140,53 +125,6 @@ pub fn sylva_ui(
     let view = ui.available_rect_before_wrap();
     overlays_ui(ui, state, view);
     view
-}
-
-fn architecture_ui(ui: &mut Ui, params: &mut crate::state::Parameters) {
-    ui.horizontal(|ui| {
-        ui.vertical(|ui| {
-            ui.label("α β γ");
-            widgets::weights_triangle_ui(ui, &mut params.direction_weights);
-        });
-        ui.vertical(|ui| {
-            ui.label("Tropism θ");
-            widgets::tropism_arrow_ui(ui, &mut params.tropism_angle);
-        });
-        ui.vertical(|ui| {
-            ui.label("Gravimorphism");
-            widgets::gravimorphism_ellipse_ui(ui, &mut params.gravimorphism);
-        });
-        ui.vertical(|ui| {
-            ui.add(
-                egui::Slider::new(&mut params.branching_angle, 0.0..=1.6).text("Branching angle"),
-            );
-            ui.add(
-                egui::Slider::new(&mut params.deflection_angle, 0.0..=0.8).text("Deflection angle"),
-            );
-            ui.checkbox(
-                &mut params.sketch_tropism,
-                "Tropism from the stroke direction",
-            );
-        });
-    });
-}
-
-fn growth_ui(ui: &mut Ui, params: &mut crate::state::Parameters) {
-    ui.horizontal_wrapped(|ui| {
-        ui.add(
-            egui::Slider::new(&mut params.apical_dominance, 0.0..=1.0).text("λ apical dominance"),
-        );
-        ui.add(
-            egui::Slider::new(&mut params.light_sensitivity, 0.0..=1.0).text("κ light sensitivity"),
-        );
-        ui.add(
-            egui::Slider::new(&mut params.shedding_threshold, 0.0..=1.0)
-                .text("Th shedding threshold"),
-        );
-        ui.add(
-            egui::Slider::new(&mut params.max_shoot_length, 1.0..=20.0).text("n_max shoot length"),
-        );
-    });
 }
 
 fn side_bar_ui(
