@@ -1,4 +1,4 @@
-//! The architecture panel's direct-manipulation widgets (Longay 2014 §5.4.2): the α/β/γ
+//! The "Advanced" panel's direct-manipulation widgets (Longay 2014 §5.4.2): the α/β/γ
 //! triangle, the tropism arrow (θ) and the gravimorphism ellipse.
 
 use egui::{Color32, Pos2, Response, Sense, Stroke, Ui, Vec2, WidgetInfo};
