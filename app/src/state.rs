@@ -18,6 +18,7 @@ use sylva_core::edit::{
     Bend, BendSettings, BrushSettings, BrushStroke, History, OperationKind, PositionalConstraint,
     StrokeCamera, Timeline, prune_at,
 };
+use sylva_core::environment::DepthConstraint;
 use sylva_core::species::Species;
 use sylva_core::{NodeId, Tree};
 
@@ -47,6 +48,11 @@ pub struct Parameters {
     pub brush_radius: f32,
     /// Growth iterations per second while brushing (negative: ungrow).
     pub grow_speed: f32,
+    /// The depth tool (Longay 2014 appendix B): attraction points only within this many metres
+    /// of the vertical plane through the tree's base that faced the camera when it was set
+    /// (flat, espalier-like crowns); none: free.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub depth_constraint_m: Option<f32>,
 }
 
 impl Default for Parameters {
@@ -90,6 +96,7 @@ impl Parameters {
             years: 5.0,
             brush_radius: 0.12,
             grow_speed: 10.0,
+            depth_constraint_m: None,
         }
     }
 
@@ -118,6 +125,13 @@ impl Parameters {
             return Err(format!(
                 "grow speed must be from -1000 to 1000 iterations/s, got {}",
                 self.grow_speed
+            ));
+        }
+        if let Some(depth) = self.depth_constraint_m
+            && !within(depth, 0.0, 100.0)
+        {
+            return Err(format!(
+                "the depth constraint must be from 0 to 100 m, got {depth}"
             ));
         }
         Ok(())
@@ -398,7 +412,11 @@ impl DesignState {
             return;
         }
         let years_changed = parameters.years != self.params.years;
+        let depth_changed = parameters.depth_constraint_m != self.params.depth_constraint_m;
         self.params = parameters.clone();
+        if depth_changed {
+            self.set_depth_constraint(parameters.depth_constraint_m);
+        }
         parameters.apply_to(&mut self.tree.species);
         if years_changed {
             self.grow_to_age(parameters.years);
@@ -577,6 +595,27 @@ impl DesignState {
                 brush.emit(&mut self.tree);
             }
         }
+    }
+
+    /// The depth tool: the tree's one depth constraint (`sylva_core::environment::DepthConstraint`),
+    /// a slab `depth_m` either side of the vertical plane through the tree's base that faces the
+    /// current camera (the world's Z axis without one); brushing, the lasso and growth keep to it.
+    fn set_depth_constraint(&mut self, depth_m: Option<f32>) {
+        let base = self
+            .tree
+            .skeleton
+            .internodes
+            .first()
+            .map_or(Vec3::ZERO, |n| n.start);
+        let view = self
+            .camera
+            .map_or(Vec3::Z, |c| c.world_from_camera.transform_vector3(Vec3::Z));
+        let normal = Vec3::new(view.x, 0.0, view.z)
+            .try_normalize()
+            .unwrap_or(Vec3::Z);
+        let constraint = depth_m.and_then(|d| DepthConstraint::through(base, normal, d));
+        self.tree.environment.set_depth_constraint(constraint);
+        self.changed();
     }
 
     fn end_stroke(&mut self, keep: bool) {

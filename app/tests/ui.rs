@@ -310,3 +310,31 @@ fn a_straighter_tree_turns_less_along_its_axes() {
     println!("mean turn along axes: straightness 0.1 {wavy:.1}°, 0.9 {straight:.1}°");
     assert!(straight + 3.0 < wavy, "straight {straight}°, wavy {wavy}°");
 }
+
+#[test]
+fn the_depth_limit_flattens_the_crown_across_the_view() {
+    // The test camera looks along −Z: the slab is about the plane z = 0.
+    let depth_of = |tree: &Tree| {
+        let mut z: Vec<f32> = tree
+            .skeleton
+            .internodes
+            .iter()
+            .map(|n| n.end.z.abs())
+            .collect();
+        z.sort_by(f32::total_cmp);
+        z[z.len() * 95 / 100]
+    };
+    let free = depth_of(&grown_after(|_| {}));
+    let flat_tree = grown_after(|h| {
+        h.get_by_label("Flat crown (depth limit facing the view)")
+            .click();
+        h.run();
+        h.get_by_role_and_label(egui::Role::Slider, "Depth limit (m)")
+            .set_value_accesskit(0.2);
+    });
+    let flat = depth_of(&flat_tree);
+    let l = flat_tree.species.internode_length_m;
+    println!("95th percentile |z|: free {free:.2} m, depth limit 0.2 m {flat:.2} m");
+    assert!(flat <= 0.2 + 2.0 * l, "the flat crown reaches {flat} m");
+    assert!(free > flat + 0.3, "free {free} m, flat {flat} m");
+}

@@ -9,6 +9,7 @@
 //! | branch angle, degrees | ψ, the branching angle |
 //! | vigour, 0 ↔ 1 | n_max, the longest shoot, 1 → [`MAX_SHOOT_INTERNODES`] internodes |
 //! | straightness, 0 ↔ 1 | α, the weight of the current heading (β and γ share the rest) |
+//! | flat crown, depth limit (m) | the depth constraint (appendix B), facing the view |
 
 use egui::Ui;
 
@@ -146,6 +147,26 @@ pub fn tree_ui(ui: &mut Ui, params: &mut Parameters, species_names: &[String]) {
             straightness,
             set_straightness,
         );
+    });
+    depth_tool_ui(ui, params);
+}
+
+/// Default half-depth when the depth limit is switched on, metres.
+const DEFAULT_DEPTH_LIMIT_M: f32 = 0.3;
+
+/// The depth tool: a flat crown, within a depth of the plane through the base facing the view.
+fn depth_tool_ui(ui: &mut Ui, params: &mut Parameters) {
+    ui.horizontal_wrapped(|ui| {
+        let mut flat = params.depth_constraint_m.is_some();
+        if ui
+            .checkbox(&mut flat, "Flat crown (depth limit facing the view)")
+            .changed()
+        {
+            params.depth_constraint_m = flat.then_some(DEFAULT_DEPTH_LIMIT_M);
+        }
+        if let Some(depth) = params.depth_constraint_m.as_mut() {
+            ui.add(egui::Slider::new(depth, 0.05..=3.0).text("Depth limit (m)"));
+        }
     });
 }
 
