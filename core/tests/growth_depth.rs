@@ -61,3 +61,38 @@ fn a_bad_depth_constraint_is_refused() {
     assert!(DepthConstraint::new(Vec3::Z, -1.0).is_none());
     assert!(DepthConstraint::new(Vec3::Z, f32::NAN).is_none());
 }
+
+#[test]
+fn a_tree_file_keeps_its_depth_constraint_in_the_format_older_files_have() {
+    let mut tree = Tree::new(Species::by_name("oak").expect("oak preset"), 5);
+    tree.environment.depth_constraint = DepthConstraint::new(Vec3::Z, 0.3);
+    tree.grow(3, None);
+    let bytes = tree.to_json_bytes().expect("serialises");
+    let json: serde_json::Value = serde_json::from_slice(&bytes).expect("json");
+    let written = &json["tree"]["environment"]["depth_constraint"];
+    let mut keys: Vec<&str> = written
+        .as_object()
+        .expect("a depth constraint object")
+        .keys()
+        .map(String::as_str)
+        .collect();
+    keys.sort();
+    // A slab through the base is written as files were before slabs had a centre, and such a
+    // file (the same bytes) loads back to the same slab.
+    assert_eq!(keys, ["depth_m", "normal"]);
+    let loaded = Tree::from_json_bytes(&bytes).expect("loads");
+    assert_eq!(
+        loaded.environment.depth_constraint,
+        tree.environment.depth_constraint
+    );
+    // A slab about another centre keeps it.
+    let mut moved = tree.clone();
+    moved.environment.depth_constraint =
+        DepthConstraint::through(Vec3::new(1.0, 0.0, 2.0), Vec3::Z, 0.3);
+    let reloaded =
+        Tree::from_json_bytes(&moved.to_json_bytes().expect("serialises")).expect("loads");
+    assert_eq!(
+        reloaded.environment.depth_constraint,
+        moved.environment.depth_constraint
+    );
+}
