@@ -162,3 +162,119 @@ pub fn run_scale(
         measurements,
     })
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::frame::{Plane, TrackingState};
+    use crate::measure::PICK_SIGMA_PX;
+    use glam::{DAffine3, DMat3, DQuat, DVec2, DVec3};
+
+    const FLOOR: Plane = Plane {
+        normal: DVec3::Y,
+        offset: 0.0,
+    };
+
+    /// Frame `index` of a walk along X, the camera `height` units above the floor looking
+    /// down 34° towards −Z; without a pose when `tracked` is false.
+    fn output(index: usize, height: f64, tracked: bool) -> FrameOutput {
+        let pitch = 34f64.to_radians();
+        let forward = DVec3::new(0.0, -pitch.sin(), -pitch.cos());
+        let right = forward.cross(DVec3::Y).normalize();
+        let down = forward.cross(right);
+        let pose = DAffine3::from_rotation_translation(
+            DQuat::from_mat3(&DMat3::from_cols(right, down, forward)),
+            DVec3::new(0.1 * index as f64, height, 0.0),
+        );
+        FrameOutput {
+            index,
+            timestamp_s: index as f64 / 30.0,
+            state: if tracked {
+                TrackingState::Ok
+            } else {
+                TrackingState::Initializing
+            },
+            world_from_camera: tracked.then_some(pose),
+            tracked_points: Vec::new(),
+            plane: tracked.then_some(FLOOR),
+        }
+    }
+
+    fn camera() -> Camera {
+        Camera::pinhole(640, 480, 525.0, 525.0, 319.5, 239.5)
+    }
+
+    /// The pixel of a world point in frame `index` of `outputs`.
+    fn pixel(outputs: &[FrameOutput], index: usize, world: DVec3) -> DVec2 {
+        let pose = outputs[index].world_from_camera.expect("tracked");
+        camera()
+            .pixel_from_camera(pose.inverse().transform_point3(world))
+            .expect("in front")
+    }
+
+    #[test]
+    fn the_median_height_scales_the_run_and_a_known_length_overrides_it() {
+        // Two frames untracked, the rest 2 units up: 0.75 m per unit at 1.5 m.
+        let outputs: Vec<FrameOutput> = (0..20).map(|i| output(i, 2.0, i >= 2)).collect();
+        let mut options = ScaleOptions {
+            holding_height_m: 1.5,
+            ..ScaleOptions::default()
+        };
+        let run = run_scale(&outputs, &camera(), 20, &options).expect("scale");
+        assert!((run.metres_per_unit() - 0.75).abs() < 1e-9);
+        let height = run.camera_height.expect("heights");
+        assert!((height.median_m - 1.5).abs() < 1e-9 && height.num_frames == 18);
+        // Ends of a 2-unit length on the floor in frame 10, said to be 1 m: 0.5 m per unit.
+        let (a, b) = (DVec3::new(0.0, 0.0, -3.0), DVec3::new(2.0, 0.0, -3.0));
+        let pixels = PixelPair {
+            frame: 10,
+            a: pixel(&outputs, 10, a),
+            b: pixel(&outputs, 10, b),
+        };
+        options.known_length = Some(KnownLength {
+            pixels,
+            length_m: 1.0,
+        });
+        options.measures = vec![pixels];
+        let run = run_scale(&outputs, &camera(), 20, &options).expect("scale");
+        assert!((run.metres_per_unit() - 0.5).abs() < 1e-6);
+        assert!((run.camera_height.expect("heights").median_m - 1.0).abs() < 1e-6);
+        let measured = run.measurements[0];
+        assert!((measured.measured_m - 1.0).abs() < 1e-6);
+        assert_eq!(measured.surfaces, [Surface::Ground; 2]);
+        // Picks on the same pixels: the pick and scale errors are the same one, counted twice.
+        let relative = run.metric.expect("metric").relative_sigma;
+        assert!(relative > 0.0 && relative < 0.02 * PICK_SIGMA_PX);
+        assert!((measured.sigma_m - 2f64.sqrt() * relative).abs() < 1e-6);
+    }
+
+    #[test]
+    fn marks_in_untracked_or_missing_frames_are_errors_naming_the_frame() {
+        let outputs: Vec<FrameOutput> = (0..20).map(|i| output(i, 2.0, i >= 2)).collect();
+        let pair = |frame| PixelPair {
+            frame,
+            a: DVec2::new(100.0, 300.0),
+            b: DVec2::new(500.0, 300.0),
+        };
+        for (frame, expected) in [
+            (1, "frame 1 has no camera pose"),
+            (25, "frame 25: the footage has no such frame"),
+        ] {
+            let options = ScaleOptions {
+                holding_height_m: 1.5,
+                known_length: Some(KnownLength {
+                    pixels: pair(frame),
+                    length_m: 1.0,
+                }),
+                measures: Vec::new(),
+            };
+            let error = run_scale(&outputs, &camera(), 20, &options).expect_err("refused");
+            assert!(error.to_string().contains(expected), "{error}");
+        }
+        let options = ScaleOptions {
+            holding_height_m: 9.0,
+            ..ScaleOptions::default()
+        };
+        assert!(run_scale(&outputs, &camera(), 20, &options).is_err());
+    }
+}
