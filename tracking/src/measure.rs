@@ -245,8 +245,8 @@ impl FrameView<'_> {
                 })
             })
             .collect();
-        // The depth limits are in metres for a metric world; a world in another unit keeps them
-        // relative to its own points.
+        // The default depth limits are metres; the tracker's world is in metres of its first
+        // guess, maybe far off, so every point in front of the camera is taken.
         let far = observations
             .iter()
             .map(|o| o.depth_m)
