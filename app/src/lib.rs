@@ -16,6 +16,7 @@ pub mod live;
 pub mod live_capture;
 pub mod player;
 pub mod render;
+pub mod scale;
 pub mod scene_tracking;
 pub mod session;
 pub mod state;

@@ -6,7 +6,9 @@
 //!
 //! **Spaces.** `world_from_camera` maps camera coordinates (OpenCV convention: X right, Y down,
 //! Z forward, metres after scale is fixed) into the world: metres, Y up along the ground-plane
-//! normal, origin on the ground plane.
+//! normal, origin on the ground plane. The tracker's metres are its first guess (the holding height
+//! at its first map); a [`scale::MetricScale`] (the median camera height, or a known length
+//! picked with [`measure`]) is the one factor that corrects them, as [`run_scale`] does for a run.
 //!
 //! **Features.** `opencv` (default on desktop): feature tracking, PnP and video readers through
 //! OpenCV; OpenCV types never leave the `cv` module. Without it, the plane, scale, map and depth
@@ -20,9 +22,11 @@ pub mod ground_plane;
 pub mod linalg;
 pub mod lk;
 pub mod map;
+pub mod measure;
 pub mod metrics;
 pub mod pose;
 pub mod rolling_shutter;
+pub mod run_scale;
 pub mod scale;
 pub mod sequence;
 pub mod world;

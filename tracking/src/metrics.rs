@@ -22,6 +22,12 @@ pub const WINDOW_FRAMES: usize = 100;
 pub struct TrajectoryErrors {
     /// RMSE of positions after one Sim(3) alignment over all tracked frames, metres.
     pub ate_rmse_m: f64,
+    /// The Sim(3) alignment's scale against 1 (true over estimated size, minus one): 0.03 is a
+    /// world 3% too small, −0.37 one 1.59 times too large. Absolute scale, which the ATE hides.
+    pub scale_error: f64,
+    /// RMSE of positions after an SE(3) alignment (rotation and translation, no scale), metres:
+    /// the error with the world's own scale.
+    pub ate_se3_m: f64,
     /// Median over consecutive windows of the ATE RMSE, each window aligned on its own, metres.
     pub window_ate_m: f64,
     /// Max / min of the per-window alignment scales (1 = no scale drift).
@@ -138,6 +144,9 @@ pub fn trajectory_errors(
 ) -> Option<TrajectoryErrors> {
     let alignment = align(pairs)?;
     let ate_rmse_m = rmse(&alignment, pairs);
+    let source: Vec<DVec3> = pairs.iter().map(|p| p.estimated.translation).collect();
+    let target: Vec<DVec3> = pairs.iter().map(|p| p.truth.translation).collect();
+    let ate_se3_m = align_similarity(&source, &target, false).map_or(f64::NAN, |a| rmse(&a, pairs));
     let mut window_errors = Vec::new();
     let mut window_scales = Vec::new();
     let last = pairs.iter().map(|p| p.index).max().unwrap_or(0);
@@ -188,6 +197,8 @@ pub fn trajectory_errors(
     );
     Some(TrajectoryErrors {
         ate_rmse_m,
+        scale_error: alignment.scale - 1.0,
+        ate_se3_m,
         window_ate_m: median(window_errors),
         scale_spread,
         rot_err_deg,
@@ -238,6 +249,42 @@ fn anchor_shift_px(
 mod tests {
     use super::*;
 
+    /// `num` frames of a wavy path and its estimate by `estimate(index, truth)`.
+    fn pairs_of(num: usize, estimate: impl Fn(usize, &DAffine3) -> DAffine3) -> Vec<PosePair> {
+        (0..num)
+            .map(|i| {
+                let f = i as f64 * 0.05;
+                let truth = DAffine3::from_rotation_translation(
+                    DQuat::from_rotation_y(f.sin() * 0.3),
+                    DVec3::new(f.sin(), 0.2 * f.cos(), 0.1 * f),
+                );
+                PosePair {
+                    index: i,
+                    estimated: estimate(i, &truth),
+                    truth,
+                }
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_metric_copy_with_noise_has_no_scale_error_and_its_noise_as_se3_error() {
+        let camera = Camera::pinhole(640, 480, 500.0, 500.0, 320.0, 240.0);
+        let pairs = pairs_of(200, |i, truth| {
+            let noise = 0.01 * if i % 2 == 0 { 1.0 } else { -1.0 };
+            let mut estimated = *truth;
+            estimated.translation += DVec3::new(noise, 0.0, 0.0);
+            estimated
+        });
+        let errors = trajectory_errors(&pairs, &camera, &pairs[0].truth, 2.0).expect("errors");
+        assert!(errors.scale_error.abs() < 0.01, "{}", errors.scale_error);
+        assert!(
+            (errors.ate_se3_m - 0.01).abs() < 1e-3,
+            "{}",
+            errors.ate_se3_m
+        );
+    }
+
     #[test]
     fn a_scaled_rotated_copy_of_the_truth_has_no_error() {
         let camera = Camera::pinhole(640, 480, 500.0, 500.0, 320.0, 240.0);
@@ -246,27 +293,21 @@ mod tests {
             DQuat::from_rotation_z(0.7),
             DVec3::new(1.0, 2.0, 3.0),
         );
-        let pairs: Vec<PosePair> = (0..300)
-            .map(|i| {
-                let f = i as f64 * 0.05;
-                let truth = DAffine3::from_rotation_translation(
-                    DQuat::from_rotation_y(f.sin() * 0.3),
-                    DVec3::new(f.sin(), 0.2 * f.cos(), 0.1 * f),
-                );
-                // Estimated = mapping⁻¹ applied to the truth (a similarity of the whole path).
-                let inv = mapping.inverse();
-                let r = DQuat::from_rotation_z(-0.7) * DQuat::from_mat3(&truth.matrix3);
-                let estimated =
-                    DAffine3::from_rotation_translation(r, inv.transform_point3(truth.translation));
-                PosePair {
-                    index: i,
-                    estimated,
-                    truth,
-                }
-            })
-            .collect();
+        // Estimated = mapping⁻¹ applied to the truth (a similarity of the whole path).
+        let inv = mapping.inverse();
+        let pairs = pairs_of(300, |_, truth| {
+            let r = DQuat::from_rotation_z(-0.7) * DQuat::from_mat3(&truth.matrix3);
+            DAffine3::from_rotation_translation(r, inv.transform_point3(truth.translation))
+        });
         let errors = trajectory_errors(&pairs, &camera, &pairs[0].truth, 2.0).expect("errors");
         assert!(errors.ate_rmse_m < 1e-9, "ate {}", errors.ate_rmse_m);
+        // The copy is 1 / 0.3 times the size: the alignment scales it by 0.3.
+        assert!(
+            (errors.scale_error - (0.3 - 1.0)).abs() < 1e-6,
+            "scale error {}",
+            errors.scale_error
+        );
+        assert!(errors.ate_se3_m > 0.1, "se3 {}", errors.ate_se3_m);
         assert!(
             (errors.scale_spread - 1.0).abs() < 1e-6,
             "spread {}",

@@ -2,7 +2,9 @@
 //! fraction and, with ground truth, the trajectory errors of [`crate::metrics`].
 
 use crate::frame::{FrameOutput, TrackingState};
+use crate::measure::MeasureError;
 use crate::metrics::{PosePair, TrajectoryErrors, trajectory_errors};
+use crate::run_scale::{RunScale, RunScaleError, ScaleOptions, run_scale};
 use crate::sequence::{FrameSource, SequenceError, SourceEvent, TumSequence, decode_depth_m};
 use crate::tracker::{Tracker, TrackerConfig, TrackerError};
 use glam::DAffine3;
@@ -21,6 +23,8 @@ pub enum RunError {
     Sequence(#[from] SequenceError),
     #[error(transparent)]
     Tracker(#[from] TrackerError),
+    #[error(transparent)]
+    Scale(#[from] RunScaleError),
 }
 
 /// A frame the source could not read.
@@ -52,7 +56,12 @@ pub struct TrackReport {
     pub num_keyframes: usize,
     pub num_map_points: usize,
     pub skipped: Vec<SkippedFrame>,
+    /// The tracker's own scale: the camera's height at its first map.
     pub scale_source: Option<crate::scale::ScaleSource>,
+    /// The run's metric scale (the median camera height, or a known length), the camera's
+    /// height and the measurements made with it. Positions, the plane and the errors of this
+    /// report are in its metres.
+    pub scale: RunScale,
     /// Rolling-shutter readout time used at the end of the run (given or estimated), ms.
     pub rolling_shutter_readout_ms: f64,
     /// The ground plane in the world at the end of the run.
@@ -78,14 +87,45 @@ pub struct TrajectoryRow {
 }
 
 /// Tracks every frame of a TUM sequence. `progress` is called after each frame with (done,
-/// total); `on_skip` with each unreadable frame.
+/// total); `on_skip` with each unreadable frame. The scale comes from the median camera
+/// height at `config.holding_height_m`.
 pub fn run_sequence(
     root: &Path,
     config: TrackerConfig,
+    progress: impl FnMut(usize, usize),
+    on_skip: impl FnMut(&SkippedFrame),
+) -> Result<TrackReport, RunError> {
+    let options = ScaleOptions {
+        holding_height_m: config.holding_height_m,
+        ..ScaleOptions::default()
+    };
+    run_sequence_scaled(root, config, &options, progress, on_skip)
+}
+
+/// [`run_sequence`] with the scale's inputs (holding height, a known length) and measurements
+/// (`sylva track`'s entry). Picks in frames the footage lacks are refused before tracking.
+pub fn run_sequence_scaled(
+    root: &Path,
+    mut config: TrackerConfig,
+    options: &ScaleOptions,
     mut progress: impl FnMut(usize, usize),
     mut on_skip: impl FnMut(&SkippedFrame),
 ) -> Result<TrackReport, RunError> {
+    config.holding_height_m = crate::scale::validate_holding_height_m(options.holding_height_m)
+        .map_err(RunScaleError::from)?;
     let sequence = TumSequence::open(root)?;
+    let num_frames = sequence.frames.len();
+    let check = |frame: usize| {
+        (frame < num_frames)
+            .then_some(())
+            .ok_or(MeasureError::NoFrame { frame, num_frames })
+    };
+    if let Some(k) = &options.known_length {
+        check(k.pixels.frame).map_err(RunScaleError::KnownLength)?;
+    }
+    for p in &options.measures {
+        check(p.frame).map_err(RunScaleError::Measure)?;
+    }
     let mut source = sequence.source();
     let total = source.len_hint().unwrap_or(0);
     let mut tracker = Tracker::new(sequence.camera, config)?;
@@ -130,7 +170,10 @@ pub fn run_sequence(
         }
         progress(done, total);
     }
-    Ok(summarise(&sequence, &tracker, outputs, timings, skipped))
+    let scale = run_scale(&outputs, &sequence.camera, num_frames, options)?;
+    Ok(summarise(
+        &sequence, &tracker, outputs, timings, skipped, scale,
+    ))
 }
 
 fn median(mut v: Vec<f64>) -> f64 {
@@ -147,8 +190,15 @@ fn summarise(
     outputs: Vec<FrameOutput>,
     timings: StageTimings,
     skipped: Vec<SkippedFrame>,
+    scale: RunScale,
 ) -> TrackReport {
     let frames = sequence.frames.len();
+    // The tracker's world in the run's metres: one factor about the origin, on the ground.
+    let metres_per_unit = scale.metres_per_unit();
+    let metric = |mut pose: DAffine3| {
+        pose.translation *= metres_per_unit;
+        pose
+    };
     let tracked: Vec<&FrameOutput> = outputs
         .iter()
         .filter(|o| o.world_from_camera.is_some())
@@ -158,7 +208,7 @@ fn summarise(
         .filter_map(|o| {
             Some(PosePair {
                 index: o.index,
-                estimated: o.world_from_camera?,
+                estimated: metric(o.world_from_camera?),
                 truth: sequence.groundtruth_at(o.timestamp_s, MAX_GROUNDTRUTH_GAP_S)?,
             })
         })
@@ -193,7 +243,7 @@ fn summarise(
             state: o.state,
             position: o
                 .world_from_camera
-                .map(|a: DAffine3| a.translation.to_array()),
+                .map(|a: DAffine3| metric(a).translation.to_array()),
             orientation: o
                 .world_from_camera
                 .map(|a| glam::DQuat::from_mat3(&a.matrix3).normalize().to_array()),
@@ -213,7 +263,14 @@ fn summarise(
         skipped,
         scale_source: tracker.world().map(|w| w.scale_source),
         rolling_shutter_readout_ms: tracker.rolling_shutter_readout_s() * 1e3,
-        plane: tracker.world().map(|w| w.plane_in_world()),
+        plane: tracker.world().map(|w| {
+            let plane = w.plane_in_world();
+            crate::frame::Plane {
+                offset: plane.offset * metres_per_unit,
+                ..plane
+            }
+        }),
+        scale,
         trajectory,
         aligned,
     }
@@ -249,7 +306,8 @@ fn first_anchor_depth_m(sequence: &TumSequence) -> f64 {
 }
 
 impl TrackReport {
-    /// The closing `key=value` line (error fields only with ground truth).
+    /// The closing `key=value` line (error fields only with ground truth; the scale's fields
+    /// once there is a scale).
     pub fn summary_line(&self) -> String {
         let mut line = format!(
             "frames={} tracked_fraction={:.3}",
@@ -257,10 +315,49 @@ impl TrackReport {
         );
         if let Some(e) = &self.errors {
             line += &format!(
-                " ate_rmse_m={:.4} window_ate_m={:.4} scale_spread={:.3} rot_err_deg={:.3} anchor_px={:.2}",
-                e.ate_rmse_m, e.window_ate_m, e.scale_spread, e.rot_err_deg, e.anchor_px
+                " ate_rmse_m={:.4} window_ate_m={:.4} scale_spread={:.3} rot_err_deg={:.3} anchor_px={:.2} scale_error={:+.4} ate_se3_m={:.4}",
+                e.ate_rmse_m,
+                e.window_ate_m,
+                e.scale_spread,
+                e.rot_err_deg,
+                e.anchor_px,
+                e.scale_error,
+                e.ate_se3_m
             );
         }
+        if let Some(m) = &self.scale.metric {
+            line += &format!(
+                " scale_source={} scale_sigma={:.4}",
+                m.source.key(),
+                m.relative_sigma
+            );
+        }
+        if let Some(h) = &self.scale.camera_height {
+            line += &format!(" camera_height_m={:.3}", h.median_m);
+        }
         line + &format!(" ms_per_frame={:.2}", self.ms_per_frame)
+    }
+
+    /// One `measured_m=` line per measurement asked for.
+    pub fn measurement_lines(&self) -> Vec<String> {
+        self.scale
+            .measurements
+            .iter()
+            .map(|m| {
+                let p = &m.pixels;
+                format!(
+                    "measure frame={} a={:.1},{:.1} on {} b={:.1},{:.1} on {} measured_m={:.4} sigma_m={:.4}",
+                    p.frame,
+                    p.a.x,
+                    p.a.y,
+                    m.surfaces[0].key(),
+                    p.b.x,
+                    p.b.y,
+                    m.surfaces[1].key(),
+                    m.measured_m,
+                    m.sigma_m
+                )
+            })
+            .collect()
     }
 }

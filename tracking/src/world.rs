@@ -80,7 +80,10 @@ impl WorldFrame {
         Some(Self {
             world_from_map,
             plane_in_map: plane,
-            scale_source: ScaleSource::CameraHeight { holding_height_m },
+            scale_source: ScaleSource::CameraHeight {
+                holding_height_m,
+                num_frames: 1,
+            },
             gravity_used,
         })
     }

@@ -1,0 +1,293 @@
+//! The window's metric scale, platform-neutral: where it comes from (the holding height with the
+//! tracked camera's median height, or a known length tapped in one frame), its uncertainty, and
+//! the measure tool (two taps: the distance in metres).
+//!
+//! The tracker's world is fixed once, in units of its first guess (the holding height at its
+//! first map). [`ScaleState::metres_per_unit`] is one factor on that world about its origin (on
+//! the ground): the window multiplies camera translations, tracked points and the plane's offset
+//! by it before planting and drawing, and keeps feeding [`ScaleState::observe`] and the picks the
+//! tracker's own (unscaled) frames.
+//!
+//! How a window calls it: every shown frame with a pose goes to `observe`; the height setting
+//! calls `set_holding_height_m`; in the known-length or measure tool each tap goes to
+//! [`TwoTaps::tap`], and the pair it returns, with that frame's [`scene_view`], goes to
+//! `mark_known_length` (after asking the length) or `measure`; the status line shows
+//! [`ScaleState::status`].
+
+use glam::{DAffine3, DVec2, Mat4, Vec3};
+use sylva_tracking::measure::{FrameView, MeasureError, PixelPair, Surface};
+use sylva_tracking::scale::{
+    CameraHeights, MetricScale, ScaleError, scale_from_known_length, validate_holding_height_m,
+};
+use sylva_tracking::{Camera, Plane, TrackedPoint};
+
+use crate::scene_tracking::SceneFrame;
+
+/// The scale of the window's world.
+#[derive(Clone, Debug, PartialEq)]
+pub struct ScaleState {
+    holding_height_m: f64,
+    heights: CameraHeights,
+    /// The scale of a known length the user marked (fixed when marked).
+    known: Option<MetricScale>,
+}
+
+/// A distance measured with the tool, metres.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Measured {
+    pub distance_m: f64,
+    /// One standard deviation: the taps' and the scale's.
+    pub sigma_m: f64,
+    pub surfaces: [Surface; 2],
+}
+
+impl ScaleState {
+    /// A state for a holding height in [`sylva_tracking::scale::HOLDING_HEIGHT_RANGE_M`].
+    pub fn new(holding_height_m: f64) -> Result<Self, ScaleError> {
+        Ok(Self {
+            holding_height_m: validate_holding_height_m(holding_height_m)?,
+            heights: CameraHeights::default(),
+            known: None,
+        })
+    }
+
+    pub fn holding_height_m(&self) -> f64 {
+        self.holding_height_m
+    }
+
+    /// A new holding height; a marked known length keeps the scale.
+    pub fn set_holding_height_m(&mut self, holding_height_m: f64) -> Result<(), ScaleError> {
+        self.holding_height_m = validate_holding_height_m(holding_height_m)?;
+        Ok(())
+    }
+
+    /// One tracked frame: its camera's height above its plane, in the tracker's world.
+    pub fn observe(&mut self, world_from_camera: &DAffine3, plane: &Plane) {
+        self.heights.push(plane, world_from_camera.translation);
+    }
+
+    /// The scale now: the known length when marked, else the camera height (None until a few
+    /// frames have a plane).
+    pub fn current(&self) -> Option<MetricScale> {
+        self.known
+            .or_else(|| self.heights.scale(self.holding_height_m))
+    }
+
+    /// Metres per unit of the tracker's world (1 until there is a scale).
+    pub fn metres_per_unit(&self) -> f64 {
+        self.current().map_or(1.0, |s| s.metres_per_unit)
+    }
+
+    /// Sets the scale from two picks `length_m` apart in `view` (the tracker's frame).
+    pub fn mark_known_length(
+        &mut self,
+        view: &FrameView,
+        pair: &PixelPair,
+        length_m: f64,
+    ) -> Result<MetricScale, KnownLengthError> {
+        let distance = view.measure(pair.a, pair.b)?;
+        let scale =
+            scale_from_known_length(distance.distance, distance.sigma, length_m, pair.frame)?
+                .ok_or(MeasureError::SamePoint { frame: pair.frame })?;
+        self.known = Some(scale);
+        Ok(scale)
+    }
+
+    /// Back to the camera height.
+    pub fn clear_known_length(&mut self) {
+        self.known = None;
+    }
+
+    /// The distance in metres between two picks in `view` (the tracker's frame).
+    pub fn measure(&self, view: &FrameView, pair: &PixelPair) -> Result<Measured, MeasureError> {
+        let d = view.measure(pair.a, pair.b)?;
+        let scale = self.metres_per_unit();
+        let relative = self.current().map_or(0.0, |s| s.relative_sigma);
+        let distance_m = d.distance * scale;
+        Ok(Measured {
+            distance_m,
+            sigma_m: (d.sigma * scale).hypot(distance_m * relative),
+            surfaces: [d.a.surface, d.b.surface],
+        })
+    }
+
+    /// The status line's words: the source and its uncertainty.
+    pub fn status(&self) -> String {
+        match self.current() {
+            Some(scale) => format!("Scale from {scale}"),
+            None => format!(
+                "Scale: waiting for the ground (phone held {} m above it)",
+                self.holding_height_m
+            ),
+        }
+    }
+}
+
+/// Why a known length was not taken.
+#[derive(Debug, thiserror::Error)]
+pub enum KnownLengthError {
+    #[error(transparent)]
+    Pick(#[from] MeasureError),
+    #[error(transparent)]
+    Length(#[from] ScaleError),
+}
+
+/// Two taps in one frame make a pair; a tap in another frame starts again.
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct TwoTaps {
+    first: Option<(usize, DVec2)>,
+}
+
+impl TwoTaps {
+    /// A tap at a raw pixel of `frame`: the pair on the second tap of a frame.
+    pub fn tap(&mut self, frame: usize, pixel: DVec2) -> Option<PixelPair> {
+        match self.first.take() {
+            Some((first_frame, a)) if first_frame == frame => {
+                Some(PixelPair { frame, a, b: pixel })
+            }
+            _ => {
+                self.first = Some((frame, pixel));
+                None
+            }
+        }
+    }
+
+    /// The first tap, while waiting for the second (to draw it).
+    pub fn pending(&self) -> Option<(usize, DVec2)> {
+        self.first
+    }
+}
+
+/// The tracked points of a scene frame in its world (from the ideal pixels and depths it keeps).
+pub fn scene_points(scene: &SceneFrame, camera: &Camera) -> Vec<TrackedPoint> {
+    let Some(world_from_camera) = scene.world_from_camera else {
+        return Vec::new();
+    };
+    scene
+        .observations
+        .iter()
+        .map(|o| {
+            let in_camera = Vec3::new(
+                (o.pixel.x - camera.cx as f32) / camera.fx as f32 * o.depth_m,
+                (o.pixel.y - camera.cy as f32) / camera.fy as f32 * o.depth_m,
+                o.depth_m,
+            );
+            TrackedPoint {
+                id: o.id,
+                pixel: o.pixel,
+                world: world_from_camera.transform_point3(in_camera),
+            }
+        })
+        .collect()
+}
+
+/// A scene frame's pose and plane as the picks want them (None without a pose).
+pub fn scene_pose_and_plane(scene: &SceneFrame) -> Option<(DAffine3, Option<Plane>)> {
+    let pose: Mat4 = scene.world_from_camera?;
+    let pose = DAffine3::from_mat4(pose.as_dmat4());
+    let plane = scene.ground.map(|g| Plane {
+        normal: g.normal.as_dvec3(),
+        offset: g.normal.dot(g.point) as f64,
+    });
+    Some((pose, plane))
+}
+
+/// The view of scene frame `frame` for picks: `points` from [`scene_points`].
+pub fn scene_view<'a>(
+    frame: usize,
+    scene: &SceneFrame,
+    camera: &'a Camera,
+    points: &'a [TrackedPoint],
+) -> Option<FrameView<'a>> {
+    let (world_from_camera, plane) = scene_pose_and_plane(scene)?;
+    Some(FrameView {
+        frame,
+        camera,
+        world_from_camera,
+        plane,
+        points,
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::{DMat3, DQuat, DVec3};
+
+    const FLOOR: Plane = Plane {
+        normal: DVec3::Y,
+        offset: 0.0,
+    };
+
+    /// A camera `height` units above the floor, looking down 34° towards −Z.
+    fn pose(height: f64) -> DAffine3 {
+        let pitch = 34f64.to_radians();
+        let forward = DVec3::new(0.0, -pitch.sin(), -pitch.cos());
+        let right = forward.cross(DVec3::Y).normalize();
+        let down = forward.cross(right);
+        DAffine3::from_rotation_translation(
+            DQuat::from_mat3(&DMat3::from_cols(right, down, forward)),
+            DVec3::new(0.0, height, 0.0),
+        )
+    }
+
+    fn pixel(camera: &Camera, pose: &DAffine3, world: DVec3) -> DVec2 {
+        camera
+            .pixel_from_camera(pose.inverse().transform_point3(world))
+            .expect("in front")
+    }
+
+    #[test]
+    fn the_scale_moves_from_the_camera_height_to_a_known_length_and_back() {
+        // The tracker's world is 2 units for a camera held at 1.5 m: 0.75 m per unit.
+        let mut state = ScaleState::new(1.5).expect("valid");
+        assert!(state.current().is_none() && state.status().contains("waiting"));
+        for _ in 0..10 {
+            state.observe(&pose(2.0), &FLOOR);
+        }
+        assert!((state.metres_per_unit() - 0.75).abs() < 1e-9);
+        assert!(
+            state.status().contains("camera's height"),
+            "{}",
+            state.status()
+        );
+        let camera = Camera::pinhole(640, 480, 525.0, 525.0, 319.5, 239.5);
+        let view = FrameView {
+            frame: 4,
+            camera: &camera,
+            world_from_camera: pose(2.0),
+            plane: Some(FLOOR),
+            points: &[],
+        };
+        // Taps on the ends of something 2 units long in this world, said to be 1.2 m: 0.6 m/unit.
+        let mut taps = TwoTaps::default();
+        let a = pixel(&camera, &pose(2.0), DVec3::new(-1.0, 0.0, -3.0));
+        let b = pixel(&camera, &pose(2.0), DVec3::new(1.0, 0.0, -3.0));
+        assert_eq!(taps.tap(4, a), None);
+        let pair = taps.tap(4, b).expect("a pair");
+        let scale = state.mark_known_length(&view, &pair, 1.2).expect("marked");
+        assert!((scale.metres_per_unit - 0.6).abs() < 1e-6);
+        assert!(
+            state.status().contains("known length"),
+            "{}",
+            state.status()
+        );
+        let measured = state.measure(&view, &pair).expect("measured");
+        assert!((measured.distance_m - 1.2).abs() < 1e-6);
+        assert!(measured.sigma_m > 0.0 && measured.sigma_m < 0.02);
+        state.clear_known_length();
+        assert!((state.metres_per_unit() - 0.75).abs() < 1e-9);
+    }
+
+    #[test]
+    fn taps_in_two_frames_start_again_and_bad_heights_are_refused() {
+        let mut taps = TwoTaps::default();
+        assert_eq!(taps.tap(1, DVec2::ONE), None);
+        assert_eq!(taps.tap(2, DVec2::ONE), None);
+        assert_eq!(taps.pending(), Some((2, DVec2::ONE)));
+        assert!(ScaleState::new(f64::NAN).is_err());
+        let mut state = ScaleState::new(1.5).expect("valid");
+        assert!(state.set_holding_height_m(40.0).is_err());
+        assert_eq!(state.holding_height_m(), 1.5);
+    }
+}
