@@ -11,8 +11,9 @@
 
 use std::path::Path;
 
-use glam::{Affine3A, Mat4};
+use glam::{Affine3A, Mat4, Vec3};
 use sylva_tracking::depth_mesh::{DepthMesh, DepthMeshConfig, Observation, PinholeIntrinsics};
+use sylva_tracking::occupancy::{OccupancyConfig, OccupancyMap};
 
 use crate::render::{GroundPlane, Intrinsics, OccluderMesh};
 
@@ -41,16 +42,8 @@ pub struct SceneMesher {
 
 impl SceneMesher {
     pub fn new(intrinsics: &Intrinsics) -> SceneMesher {
-        let camera = PinholeIntrinsics {
-            width: intrinsics.width,
-            height: intrinsics.height,
-            fx: intrinsics.fx,
-            fy: intrinsics.fy,
-            cx: intrinsics.cx,
-            cy: intrinsics.cy,
-        };
         SceneMesher {
-            depth_mesh: DepthMesh::new(camera, DepthMeshConfig::default()),
+            depth_mesh: DepthMesh::new(pinhole_of(intrinsics), DepthMeshConfig::default()),
         }
     }
 
@@ -69,6 +62,85 @@ impl SceneMesher {
             positions: mesh.positions,
             indices: mesh.indices,
         }
+    }
+}
+
+/// The occupancy of the scene (free space carved along the rays, surfaces where the points are)
+/// from the depth meshes of keyframes' tracked points: the scene that shapes the tree's growth
+/// (Longay 2014 §5.4.3). A frame becomes a keyframe once the ground is found (the world is then
+/// fixed) and the camera has moved or turned far enough from the last keyframe. Live tracking,
+/// replays and scripted sessions feed it the same recorded observations in the same order, so
+/// they grow the same tree.
+pub struct SceneOccupancy {
+    camera: PinholeIntrinsics,
+    map: OccupancyMap,
+    last_keyframe: Option<Affine3A>,
+}
+
+/// A new keyframe once the camera moved this far (m) from the last one ...
+const KEYFRAME_BASELINE_M: f32 = 0.12;
+/// ... or turned this much (radians).
+const KEYFRAME_TURN_RAD: f32 = 0.1;
+/// Fewer tracked points than this make no keyframe (too little surface to carve with).
+const KEYFRAME_MIN_POINTS: usize = 40;
+
+impl SceneOccupancy {
+    pub fn new(intrinsics: &Intrinsics) -> SceneOccupancy {
+        SceneOccupancy {
+            camera: pinhole_of(intrinsics),
+            map: OccupancyMap::new(OccupancyConfig::default()),
+            last_keyframe: None,
+        }
+    }
+
+    /// The map so far.
+    pub fn map(&self) -> &OccupancyMap {
+        &self.map
+    }
+
+    /// Takes one frame's tracked points seen from `world_from_camera`; integrates them when the
+    /// frame is a new keyframe (returns whether it was).
+    pub fn observe(
+        &mut self,
+        observations: &[Observation],
+        world_from_camera: Mat4,
+        ground_found: bool,
+    ) -> bool {
+        let pose = Affine3A::from_mat4(world_from_camera);
+        let far_enough = self.last_keyframe.is_none_or(|last| {
+            let moved = Vec3::from(last.translation).distance(Vec3::from(pose.translation));
+            let turn = (last.matrix3.inverse() * pose.matrix3)
+                .to_cols_array()
+                .iter()
+                .step_by(4)
+                .sum::<f32>();
+            // trace(R) = 1 + 2 cos θ.
+            let angle = ((turn - 1.0) * 0.5).clamp(-1.0, 1.0).acos();
+            moved >= KEYFRAME_BASELINE_M || angle >= KEYFRAME_TURN_RAD
+        });
+        if !ground_found
+            || !far_enough
+            || observations.len() < KEYFRAME_MIN_POINTS
+            || !pose.is_finite()
+        {
+            return false;
+        }
+        let mut mesh = DepthMesh::new(self.camera, DepthMeshConfig::default());
+        mesh.update(observations);
+        self.map.integrate(&mesh, &pose);
+        self.last_keyframe = Some(pose);
+        true
+    }
+}
+
+fn pinhole_of(intrinsics: &Intrinsics) -> PinholeIntrinsics {
+    PinholeIntrinsics {
+        width: intrinsics.width,
+        height: intrinsics.height,
+        fx: intrinsics.fx,
+        fy: intrinsics.fy,
+        cx: intrinsics.cx,
+        cy: intrinsics.cy,
     }
 }
 

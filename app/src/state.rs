@@ -11,16 +11,22 @@
 
 use std::collections::BTreeMap;
 
-use glam::{Quat, Vec2, Vec3};
+use glam::{Affine3A, Mat4, Quat, Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 use sylva_core::edit::{
     Bend, BendSettings, BrushPlane, BrushSettings, BrushStroke, History, OperationKind,
     PositionalConstraint, Timeline, prune_at,
 };
+use sylva_core::environment::{Scene, SceneMode};
 use sylva_core::species::Species;
 use sylva_core::{NodeId, Tree};
+use sylva_tracking::depth_mesh::Observation;
 
-use crate::render::ViewCamera;
+use crate::planting::{
+    SceneChoice, TreeScene, camera_in_tree, ground_point_at_pixel, world_from_tree_at,
+};
+use crate::render::{GroundPlane, Intrinsics, ViewCamera};
+use crate::scene_tracking::SceneOccupancy;
 
 /// Growth and brush parameters the UI exposes.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -46,6 +52,9 @@ pub struct Parameters {
     pub brush_radius: f32,
     /// Growth iterations per second while brushing (negative: ungrow).
     pub grow_speed: f32,
+    /// How the tracked scene shapes growth (absent in older sessions: free).
+    #[serde(default)]
+    pub scene_mode: SceneChoice,
 }
 
 impl Default for Parameters {
@@ -89,6 +98,7 @@ impl Parameters {
             years: 5.0,
             brush_radius: 0.12,
             grow_speed: 10.0,
+            scene_mode: SceneChoice::Free,
         }
     }
 
@@ -243,28 +253,64 @@ pub struct DesignState {
     last_tap: Option<(f64, Vec2)>,
     pub selected: Option<NodeId>,
     bend: Option<BendGesture>,
+    /// The camera in tree space (None while tracking is lost or before planting): picking,
+    /// the brush and gestures work in tree space.
     pub camera: Option<ViewCamera>,
+    /// The camera in the world.
+    world_camera: Option<ViewCamera>,
+    /// The ground plane in the world, once found.
+    pub ground: Option<GroundPlane>,
+    /// Where the tree stands in the world; None until a tap on the ground plants it.
+    pub world_from_tree: Option<Affine3A>,
+    /// The touch dragging the trunk base (moving the tree).
+    moving_base: Option<u64>,
+    /// The occupancy of the tracked scene (from the first frame with tracked points).
+    occupancy: Option<SceneOccupancy>,
     pub time_s: f64,
     /// Bumped whenever the tree changes (the renderer re-meshes on change).
     pub revision: u64,
     grow_debt: f32,
 }
 
-/// Grows `tree` autonomously to iteration `target` (keeping each iteration in `timeline`), or
-/// ungrows it to the kept iteration `target`.
+/// Grows `tree` autonomously to iteration `target` (keeping each iteration in `timeline`) against
+/// the scene when one is given, or ungrows it to the kept iteration `target`.
 fn move_to_iteration(
     tree: &mut Tree,
     timeline: &mut Timeline,
     target: u32,
+    scene: Option<(&dyn Scene, SceneMode)>,
 ) -> Result<(), sylva_core::edit::EditError> {
     if target < tree.iteration {
         return timeline.go_to(tree, target);
     }
     while tree.iteration < target {
-        tree.grow(1, None);
+        tree.grow(1, scene);
         timeline.keep(tree);
     }
     Ok(())
+}
+
+/// The scene growth reacts to in `choice`, in tree space (None for free growth or without a
+/// map).
+fn growth_scene(
+    choice: SceneChoice,
+    occupancy: &Option<SceneOccupancy>,
+    world_from_tree: Option<Affine3A>,
+) -> Option<(TreeScene<'_>, SceneMode)> {
+    Some((tree_scene(occupancy, world_from_tree)?, choice.mode()?))
+}
+
+/// The tracked scene in tree space, when the tree is planted and a map exists.
+fn tree_scene(
+    occupancy: &Option<SceneOccupancy>,
+    world_from_tree: Option<Affine3A>,
+) -> Option<TreeScene<'_>> {
+    let map = occupancy.as_ref()?.map();
+    (map.num_keyframes() > 0).then_some(TreeScene {
+        map,
+        world_from_tree: world_from_tree?,
+        ground_clearance_m: sylva_tracking::occupancy::OccupancyConfig::default().voxel_size_m,
+    })
 }
 
 /// Autonomous iterations of the sapling a design starts from: a trunk with a few laterals to
@@ -281,9 +327,19 @@ fn planted(species: Species, seed: u64) -> Tree {
 const MAX_UNDO: usize = 64;
 
 impl DesignState {
-    /// A sapling of `params.species` (the default species for an unknown name) at the ground
-    /// origin: its seedling grown [`PLANTED_ITERATIONS`] autonomous iterations.
+    /// A sapling of `params.species` (the default species for an unknown name) planted at the
+    /// world origin: its seedling grown [`PLANTED_ITERATIONS`] autonomous iterations (version 2
+    /// sessions, and tests that need no planting).
     pub fn new(seed: u64, params: Parameters) -> DesignState {
+        DesignState {
+            world_from_tree: Some(Affine3A::IDENTITY),
+            ..DesignState::unplanted(seed, params)
+        }
+    }
+
+    /// The same sapling waiting to be planted: nothing is shown or edited until a tap on the
+    /// ground plane plants it (the app and version 3 sessions).
+    pub fn unplanted(seed: u64, params: Parameters) -> DesignState {
         let mut species = species_named(&params.species);
         params.apply_to(&mut species);
         let tree = planted(species, seed);
@@ -303,6 +359,11 @@ impl DesignState {
             selected: None,
             bend: None,
             camera: None,
+            world_camera: None,
+            ground: None,
+            world_from_tree: None,
+            moving_base: None,
+            occupancy: None,
             time_s: 0.0,
             revision: 0,
             grow_debt: 0.0,
@@ -329,7 +390,8 @@ impl DesignState {
     /// device, held touches become selections, and while a stroke is painted the tree grows
     /// towards it (brush-guided iterations, `grow_speed` per second).
     pub fn advance_frame(&mut self, camera: Option<ViewCamera>, time_s: f64, dt_s: f32) {
-        self.camera = camera;
+        self.world_camera = camera;
+        self.update_tree_camera();
         self.time_s = time_s;
         if self.stroke.is_some() {
             self.add_stroke_point();
@@ -344,13 +406,101 @@ impl DesignState {
         }
     }
 
+    /// Takes the scene of the frame about to be shown: its ground plane and, once the ground is
+    /// found, its tracked points for the occupancy of the scene (call before
+    /// [`Self::advance_frame`]).
+    pub fn observe_scene(
+        &mut self,
+        intrinsics: &Intrinsics,
+        world_from_camera: Option<Mat4>,
+        ground: Option<GroundPlane>,
+        observations: &[Observation],
+    ) {
+        self.ground = ground;
+        if let Some(world_from_camera) = world_from_camera {
+            self.occupancy
+                .get_or_insert_with(|| SceneOccupancy::new(intrinsics))
+                .observe(observations, world_from_camera, ground.is_some());
+        }
+    }
+
+    /// The camera in the world (the tracked pose of the frame shown).
+    pub fn world_camera(&self) -> Option<ViewCamera> {
+        self.world_camera
+    }
+
+    /// Tree space from the world (identity before planting).
+    pub fn tree_from_world(&self) -> Affine3A {
+        self.world_from_tree.unwrap_or(Affine3A::IDENTITY).inverse()
+    }
+
+    /// Whether the tree is planted (shown and editable).
+    pub fn is_planted(&self) -> bool {
+        self.world_from_tree.is_some()
+    }
+
+    /// Number of keyframes in the occupancy of the scene.
+    pub fn num_scene_keyframes(&self) -> usize {
+        self.occupancy
+            .as_ref()
+            .map_or(0, |o| o.map().num_keyframes())
+    }
+
+    fn update_tree_camera(&mut self) {
+        let tree_from_world = self.tree_from_world();
+        self.camera = self
+            .world_camera
+            .filter(|_| self.is_planted())
+            .map(|c| camera_in_tree(&c, &tree_from_world));
+    }
+
+    /// Plants (or moves) the tree where the ray through `pixel` meets the ground plane; false
+    /// when there is no camera or ground yet, or the ray misses the ground.
+    fn plant_at(&mut self, pixel: Vec2) -> bool {
+        let (Some(camera), Some(ground)) = (self.world_camera, self.ground) else {
+            return false;
+        };
+        let Some(point) = ground_point_at_pixel(&camera, &ground, pixel) else {
+            return false;
+        };
+        self.world_from_tree = Some(world_from_tree_at(point, &ground));
+        self.update_tree_camera();
+        self.changed();
+        true
+    }
+
+    /// A touch starting on the trunk base drags the tree.
+    fn begin_move(&mut self, id: u64, pixel: Vec2) -> bool {
+        let on_base = self
+            .camera
+            .and_then(|c| c.pixel_from_world(Vec3::ZERO))
+            .is_some_and(|base| base.distance(pixel) <= PICK_RADIUS_PX);
+        if on_base {
+            self.moving_base = Some(id);
+        }
+        on_base
+    }
+
     /// One brush-guided growth iteration towards the persistent points of the stroke.
     fn grow_once(&mut self) {
         let Some(brush) = self.brush.as_mut() else {
             return;
         };
         brush.emit_dab(&mut self.tree);
-        let stats = brush.iterate(&mut self.tree);
+        let stats = match growth_scene(
+            self.params.scene_mode,
+            &self.occupancy,
+            self.world_from_tree,
+        ) {
+            Some((scene, mode)) => {
+                brush.emit(&mut self.tree);
+                self.tree.step(sylva_core::growth::StepOptions {
+                    autonomous: false,
+                    scene: Some((&scene, mode)),
+                })
+            }
+            None => brush.iterate(&mut self.tree),
+        };
         self.timeline.keep(&self.tree);
         if stats.num_new_internodes > 0 {
             self.changed();
@@ -387,6 +537,7 @@ impl DesignState {
             self.params = Parameters {
                 brush_radius: brush.0,
                 grow_speed: brush.1,
+                scene_mode: parameters.scene_mode,
                 ..Parameters::for_species(&species)
             };
             self.tree = planted(species, self.seed);
@@ -397,8 +548,22 @@ impl DesignState {
             return;
         }
         let years_changed = parameters.years != self.params.years;
+        let prune_now = parameters.scene_mode == SceneChoice::PruneToScene
+            && self.params.scene_mode != SceneChoice::PruneToScene;
         self.params = parameters.clone();
         parameters.apply_to(&mut self.tree.species);
+        if prune_now {
+            // Choosing "prune to the scene" cuts what free growth pushed into it.
+            if let Some(scene) = tree_scene(&self.occupancy, self.world_from_tree)
+                && self.tree.prune_to_scene(&scene) > 0
+            {
+                self.timeline.keep(&self.tree);
+                self.brush = None;
+                self.bend = None;
+                self.selected = None;
+                self.changed();
+            }
+        }
         if years_changed {
             self.grow_to_age(parameters.years);
         }
@@ -413,8 +578,14 @@ impl DesignState {
         let target = self.tree.species.iterations_for_years(years.max(0.0));
         let earliest = self.timeline.range().map_or(target, |(first, _)| first);
         let target = target.max(earliest);
+        let scene = growth_scene(
+            self.params.scene_mode,
+            &self.occupancy,
+            self.world_from_tree,
+        );
+        let scene = scene.as_ref().map(|(s, m)| (s as &dyn Scene, *m));
         if target == self.tree.iteration
-            || move_to_iteration(&mut self.tree, &mut self.timeline, target).is_err()
+            || move_to_iteration(&mut self.tree, &mut self.timeline, target, scene).is_err()
         {
             return;
         }
@@ -437,10 +608,16 @@ impl DesignState {
                 .saturating_sub(iterations.unsigned_abs())
         };
         let timeline = &mut self.timeline;
+        let scene = growth_scene(
+            self.params.scene_mode,
+            &self.occupancy,
+            self.world_from_tree,
+        );
+        let scene = scene.as_ref().map(|(s, m)| (s as &dyn Scene, *m));
         let result = self
             .history
             .perform(OperationKind::Grow, &mut self.tree, |tree| {
-                move_to_iteration(tree, timeline, target)
+                move_to_iteration(tree, timeline, target, scene)
             });
         if result.is_ok() {
             self.changed();
@@ -460,6 +637,7 @@ impl DesignState {
                     },
                 );
                 match self.touches.len() {
+                    1 if !self.is_planted() || self.begin_move(id, pixel) => {}
                     1 => self.begin_stroke(pixel),
                     3 => self.begin_bend(),
                     _ => self.end_stroke(false),
@@ -470,7 +648,11 @@ impl DesignState {
                     t.now = pixel;
                     t.moved |= t.now.distance(t.start) > TAP_SLOP_PX;
                 }
-                if self.bend.is_some() {
+                if self.moving_base == Some(id) {
+                    if self.touches.get(&id).is_some_and(|t| t.moved) {
+                        self.plant_at(pixel);
+                    }
+                } else if self.bend.is_some() {
                     self.update_bend();
                 } else if let Some(stroke) = self.stroke.as_mut() {
                     stroke.pixel = pixel;
@@ -487,6 +669,16 @@ impl DesignState {
                 }
                 let is_tap =
                     touch.is_some_and(|t| !t.moved && self.time_s - t.start_time_s < HOLD_S);
+                if self.moving_base.take_if(|m| *m == id).is_some() && !is_tap {
+                    return;
+                }
+                if !self.is_planted() {
+                    // Before planting, a tap on the ground plants the tree there.
+                    if is_tap && self.touches.is_empty() {
+                        self.plant_at(pixel);
+                    }
+                    return;
+                }
                 self.end_stroke(!is_tap);
                 if is_tap {
                     self.tap(pixel);
