@@ -191,7 +191,7 @@ fn replay_against_truth(session_path: &Path, margin_m: f32) -> Outcome {
             })
             .count()
     };
-    let (mut inside, mut sizes, mut base) = (Vec::new(), Vec::new(), None);
+    let (mut inside, mut sizes, mut base, mut keyframes) = (Vec::new(), Vec::new(), None, 0);
     let report = replay(session_path, None, false, |_, state| {
         let count = state.world_from_tree.map_or(0, |m| inside_count(state, m));
         inside.push(count);
@@ -199,8 +199,13 @@ fn replay_against_truth(session_path: &Path, margin_m: f32) -> Outcome {
         base = state
             .world_from_tree
             .map(|m| to_truth(Vec3::from(m.translation)));
+        keyframes = state.num_scene_keyframes();
     })
     .expect("replay");
+    println!(
+        "{} frames replayed in {:.1} ms each (scene from {keyframes} keyframes)",
+        report.num_frames, report.ms_per_frame
+    );
     Outcome {
         tree_sha256: report.tree_sha256,
         inside,
