@@ -13,7 +13,7 @@ use crate::live::{FootageRecorder, LiveFrame, LiveNext, LiveStream, intrinsics_o
 use crate::render::{GroundPlane, ViewCamera};
 use crate::scene_tracking::{SceneFrame, SceneTracker};
 use crate::session::{Session, frame_dt};
-use crate::state::{DesignState, InputEvent, Parameters};
+use crate::state::{DesignState, InputEvent, Parameters, TouchPhase};
 use crate::ui::UiState;
 
 /// Seed of trees planted by the app.
@@ -49,6 +49,8 @@ pub struct Player {
     frame_clock_s: f64,
     /// Time of the last streamed frame shown.
     last_frame_time_s: f64,
+    /// Plant at the world origin once the ground is found (`sylva view --plant-at-origin`).
+    pub plant_at_origin: bool,
 }
 
 impl Player {
@@ -62,7 +64,8 @@ impl Player {
         let tracker = SceneTracker::open(&footage.root, footage.intrinsics)?;
         Ok(Player {
             session: Session::new(footage_ref, DEFAULT_SEED, params.clone()),
-            design: DesignState::unplanted(DEFAULT_SEED, params),
+            design: DesignState::unplanted(DEFAULT_SEED, params)
+                .with_scene_worker(&footage.intrinsics),
             footage,
             ui,
             frame: 0,
@@ -71,6 +74,7 @@ impl Player {
             last_tick_s: None,
             frame_clock_s: 0.0,
             last_frame_time_s: 0.0,
+            plant_at_origin: false,
         })
     }
 
@@ -97,7 +101,8 @@ impl Player {
         let params = Parameters::default();
         Ok(Player {
             session: Session::new(root, DEFAULT_SEED, params.clone()),
-            design: DesignState::unplanted(DEFAULT_SEED, params),
+            design: DesignState::unplanted(DEFAULT_SEED, params)
+                .with_scene_worker(&intrinsics_of(&camera)),
             footage,
             ui: UiState {
                 live: true,
@@ -114,6 +119,7 @@ impl Player {
             last_tick_s: None,
             frame_clock_s: 0.0,
             last_frame_time_s: 0.0,
+            plant_at_origin: false,
         })
     }
 
@@ -206,8 +212,26 @@ impl Player {
         let started = std::time::Instant::now();
         self.design
             .advance_frame(self.camera(), time_s, frame_dt(time_s - previous_time_s));
-        self.ui.planted = self.design.is_planted();
         self.ui.budget.growth_ms = started.elapsed().as_secs_f32() * 1000.0;
+        if self.plant_at_origin
+            && !self.design.is_planted()
+            && self.design.ground.is_some()
+            && let Some(p) = self
+                .design
+                .world_camera()
+                .and_then(|c| c.pixel_from_world(Vec3::ZERO))
+        {
+            // A tap at the origin's pixel, as the user would make it (and recorded so).
+            for phase in [TouchPhase::Start, TouchPhase::End] {
+                self.input(InputEvent::Touch {
+                    phase,
+                    id: 0,
+                    x: p.x,
+                    y: p.y,
+                });
+            }
+        }
+        self.ui.planted = self.design.is_planted();
     }
 
     /// The tracked camera of the current frame in tree space (how the frame is drawn: the

@@ -9,7 +9,9 @@
 //! World: metres, Y up, origin on the ground plane (fixed once the plane is found, so a planted
 //! tree never moves).
 
+use std::collections::VecDeque;
 use std::path::Path;
+use std::sync::Arc;
 
 use glam::{Affine3A, Mat4, Vec3};
 use sylva_tracking::depth_mesh::{DepthMesh, DepthMeshConfig, Observation, PinholeIntrinsics};
@@ -68,15 +70,25 @@ impl SceneMesher {
 /// The occupancy of the scene (free space carved along the rays, surfaces where the points are)
 /// from the depth meshes of keyframes' tracked points: the scene that shapes the tree's growth
 /// (Longay 2014 §5.4.3). A frame becomes a keyframe once the ground is found (the world is then
-/// fixed) and the camera has moved or turned far enough from the last keyframe. Live tracking,
-/// replays and scripted sessions feed it the same recorded observations in the same order, so
-/// they grow the same tree.
+/// fixed) and the camera has moved or turned far enough from the last keyframe.
+///
+/// A keyframe joins the map [`SCENE_LATENCY_FRAMES`] shown frames after it was taken. The
+/// window integrates keyframes on a worker thread ([`SceneOccupancy::with_worker`]), which has
+/// that long; replays and scripted sessions integrate them inline at the same frame. Both feed
+/// the same recorded observations in the same order, so growth sees the same map at every frame
+/// and a session replays to the tree it was designed as.
 pub struct SceneOccupancy {
     camera: PinholeIntrinsics,
-    map: OccupancyMap,
     last_keyframe: Option<Affine3A>,
+    /// Frames observed so far.
+    num_frames: usize,
+    /// Keyframes taken, not yet in the map, with the frame at which they join it.
+    pending: VecDeque<(usize, Keyframe)>,
+    integrator: Integrator,
 }
 
+/// Shown frames between taking a keyframe and growing against it.
+pub const SCENE_LATENCY_FRAMES: usize = 10;
 /// A new keyframe once the camera moved this far (m) from the last one ...
 const KEYFRAME_BASELINE_M: f32 = 0.12;
 /// ... or turned this much (radians).
@@ -84,52 +96,142 @@ const KEYFRAME_TURN_RAD: f32 = 0.1;
 /// Fewer tracked points than this make no keyframe (too little surface to carve with).
 const KEYFRAME_MIN_POINTS: usize = 40;
 
+/// One keyframe's tracked points and pose.
+struct Keyframe {
+    observations: Vec<Observation>,
+    world_from_camera: Affine3A,
+}
+
+enum Integrator {
+    Inline(OccupancyMap),
+    /// The worker owns the map and sends a copy after each keyframe, in order.
+    Worker {
+        keyframes: std::sync::mpsc::Sender<Keyframe>,
+        maps: std::sync::mpsc::Receiver<Arc<OccupancyMap>>,
+        current: Arc<OccupancyMap>,
+    },
+}
+
+fn integrate(map: &mut OccupancyMap, camera: PinholeIntrinsics, keyframe: &Keyframe) {
+    let mut mesh = DepthMesh::new(camera, DepthMeshConfig::default());
+    mesh.update(&keyframe.observations);
+    map.integrate(&mesh, &keyframe.world_from_camera);
+}
+
 impl SceneOccupancy {
+    /// Integrating keyframes on the calling thread.
     pub fn new(intrinsics: &Intrinsics) -> SceneOccupancy {
         SceneOccupancy {
             camera: pinhole_of(intrinsics),
-            map: OccupancyMap::new(OccupancyConfig::default()),
             last_keyframe: None,
+            num_frames: 0,
+            pending: VecDeque::new(),
+            integrator: Integrator::Inline(OccupancyMap::new(OccupancyConfig::default())),
         }
     }
 
-    /// The map so far.
-    pub fn map(&self) -> &OccupancyMap {
-        &self.map
+    /// Integrating keyframes on a worker thread (the window): the same maps at the same frames
+    /// as [`Self::new`], the UI thread waiting only if the worker is more than
+    /// [`SCENE_LATENCY_FRAMES`] behind.
+    pub fn with_worker(intrinsics: &Intrinsics) -> SceneOccupancy {
+        let camera = pinhole_of(intrinsics);
+        let (keyframes, jobs) = std::sync::mpsc::channel::<Keyframe>();
+        let (done, maps) = std::sync::mpsc::channel();
+        let spawned = std::thread::Builder::new()
+            .name("sylva-occupancy".into())
+            .spawn(move || {
+                let mut map = OccupancyMap::new(OccupancyConfig::default());
+                for keyframe in jobs {
+                    integrate(&mut map, camera, &keyframe);
+                    if done.send(Arc::new(map.clone())).is_err() {
+                        return;
+                    }
+                }
+            });
+        let mut occupancy = SceneOccupancy::new(intrinsics);
+        match spawned {
+            Ok(_) => {
+                occupancy.integrator = Integrator::Worker {
+                    keyframes,
+                    maps,
+                    current: Arc::new(OccupancyMap::new(OccupancyConfig::default())),
+                }
+            }
+            Err(e) => eprintln!("warning: no occupancy worker ({e}); integrating inline"),
+        }
+        occupancy
     }
 
-    /// Takes one frame's tracked points seen from `world_from_camera`; integrates them when the
-    /// frame is a new keyframe (returns whether it was).
+    /// The map growth uses now.
+    pub fn map(&self) -> &OccupancyMap {
+        match &self.integrator {
+            Integrator::Inline(map) => map,
+            Integrator::Worker { current, .. } => current,
+        }
+    }
+
+    /// Takes the next shown frame's tracked points seen from `world_from_camera` (None while
+    /// tracking is lost); keeps it as a keyframe when it is one, and brings the keyframes due
+    /// at this frame into the map. Returns whether the frame was a keyframe.
     pub fn observe(
         &mut self,
         observations: &[Observation],
-        world_from_camera: Mat4,
+        world_from_camera: Option<Mat4>,
         ground_found: bool,
     ) -> bool {
-        let pose = Affine3A::from_mat4(world_from_camera);
-        let far_enough = self.last_keyframe.is_none_or(|last| {
-            let moved = Vec3::from(last.translation).distance(Vec3::from(pose.translation));
-            let turn = (last.matrix3.inverse() * pose.matrix3)
-                .to_cols_array()
-                .iter()
-                .step_by(4)
-                .sum::<f32>();
-            // trace(R) = 1 + 2 cos θ.
-            let angle = ((turn - 1.0) * 0.5).clamp(-1.0, 1.0).acos();
-            moved >= KEYFRAME_BASELINE_M || angle >= KEYFRAME_TURN_RAD
-        });
-        if !ground_found
-            || !far_enough
-            || observations.len() < KEYFRAME_MIN_POINTS
-            || !pose.is_finite()
-        {
-            return false;
+        self.num_frames += 1;
+        let keyframe = world_from_camera
+            .map(Affine3A::from_mat4)
+            .filter(|pose| ground_found && pose.is_finite() && self.is_new_keyframe(pose))
+            .filter(|_| observations.len() >= KEYFRAME_MIN_POINTS);
+        if let Some(pose) = keyframe {
+            self.last_keyframe = Some(pose);
+            let keyframe = Keyframe {
+                observations: observations.to_vec(),
+                world_from_camera: pose,
+            };
+            let keyframe = match &self.integrator {
+                // The worker starts on it now; only the due frame is remembered.
+                Integrator::Worker { keyframes, .. } => match keyframes.send(keyframe) {
+                    Ok(()) => Keyframe {
+                        observations: Vec::new(),
+                        world_from_camera: pose,
+                    },
+                    Err(std::sync::mpsc::SendError(keyframe)) => keyframe,
+                },
+                Integrator::Inline(_) => keyframe,
+            };
+            self.pending
+                .push_back((self.num_frames + SCENE_LATENCY_FRAMES, keyframe));
         }
-        let mut mesh = DepthMesh::new(self.camera, DepthMeshConfig::default());
-        mesh.update(observations);
-        self.map.integrate(&mesh, &pose);
-        self.last_keyframe = Some(pose);
-        true
+        while self
+            .pending
+            .front()
+            .is_some_and(|(due, _)| *due <= self.num_frames)
+        {
+            let Some((_, keyframe)) = self.pending.pop_front() else {
+                break;
+            };
+            match &mut self.integrator {
+                Integrator::Inline(map) => integrate(map, self.camera, &keyframe),
+                Integrator::Worker { maps, current, .. } => match maps.recv() {
+                    Ok(map) => *current = map,
+                    Err(_) => eprintln!("warning: the occupancy worker stopped"),
+                },
+            }
+        }
+        keyframe.is_some()
+    }
+
+    fn is_new_keyframe(&self, pose: &Affine3A) -> bool {
+        self.last_keyframe.is_none_or(|last| {
+            let moved = Vec3::from(last.translation).distance(Vec3::from(pose.translation));
+            // trace(R) = 1 + 2 cos θ.
+            let relative = last.matrix3.transpose() * pose.matrix3;
+            let trace = relative.x_axis.x + relative.y_axis.y + relative.z_axis.z;
+            let angle = ((trace - 1.0) * 0.5).clamp(-1.0, 1.0).acos();
+            moved >= KEYFRAME_BASELINE_M || angle >= KEYFRAME_TURN_RAD
+        })
     }
 }
 

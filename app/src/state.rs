@@ -417,11 +417,16 @@ impl DesignState {
         observations: &[Observation],
     ) {
         self.ground = ground;
-        if let Some(world_from_camera) = world_from_camera {
-            self.occupancy
-                .get_or_insert_with(|| SceneOccupancy::new(intrinsics))
-                .observe(observations, world_from_camera, ground.is_some());
-        }
+        self.occupancy
+            .get_or_insert_with(|| SceneOccupancy::new(intrinsics))
+            .observe(observations, world_from_camera, ground.is_some());
+    }
+
+    /// Builds the scene's occupancy on a worker thread (the window; replays build the same map
+    /// inline, at the same frames).
+    pub fn with_scene_worker(mut self, intrinsics: &Intrinsics) -> DesignState {
+        self.occupancy = Some(SceneOccupancy::with_worker(intrinsics));
+        self
     }
 
     /// The camera in the world (the tracked pose of the frame shown).

@@ -71,6 +71,7 @@ fn view_args(video: &Path) -> ViewArgs {
         frame: 0,
         paused: false,
         orbit: false,
+        plant_at_origin: false,
     }
 }
 

@@ -8,6 +8,7 @@ use egui_kittest::kittest::Queryable;
 use glam::{Vec2, Vec3};
 use sylva_app::planting::SceneChoice;
 use sylva_app::render::{GroundPlane, Intrinsics, ViewCamera};
+use sylva_app::scene_tracking::{SCENE_LATENCY_FRAMES, SceneOccupancy};
 use sylva_app::state::{DesignState, InputEvent, Parameters};
 use sylva_app::ui::{UiState, sylva_ui};
 use sylva_tracking::depth_mesh::Observation;
@@ -56,13 +57,16 @@ fn wall_points(camera: &ViewCamera) -> Vec<Observation> {
 fn app() -> App {
     let mut design = DesignState::new(7, Parameters::default());
     let camera = camera();
-    design.observe_scene(
-        &camera.intrinsics,
-        Some(camera.world_from_camera),
-        Some(GroundPlane::default()),
-        &wall_points(&camera),
-    );
-    design.advance_frame(Some(camera), 0.0, 1.0 / 30.0);
+    // The camera holds still while a keyframe joins the map.
+    for step in 0..=SCENE_LATENCY_FRAMES {
+        design.observe_scene(
+            &camera.intrinsics,
+            Some(camera.world_from_camera),
+            Some(GroundPlane::default()),
+            &wall_points(&camera),
+        );
+        design.advance_frame(Some(camera), step as f64 / 30.0, 1.0 / 30.0);
+    }
     assert_eq!(design.num_scene_keyframes(), 1);
     App {
         ui: UiState {
@@ -158,4 +162,31 @@ fn the_scene_buttons_keep_the_tree_out_of_a_wall_that_free_growth_enters() {
         "pruning left internodes in the wall"
     );
     assert!(pruned.tree.skeleton.len() < n_free, "pruning cut nothing");
+}
+
+#[test]
+fn the_window_s_occupancy_worker_builds_the_same_map_as_a_replay_at_every_frame() {
+    let intrinsics = camera().intrinsics;
+    let mut inline = SceneOccupancy::new(&intrinsics);
+    let mut worker = SceneOccupancy::with_worker(&intrinsics);
+    for step in 0..40 {
+        // The camera steps sideways 0.2 m every 8 frames: a keyframe each time.
+        let eye = Vec3::new(0.2 * (step / 8) as f32 - 0.4, 1.2, 2.5);
+        let camera = ViewCamera::looking_at(intrinsics, eye, Vec3::new(0.0, 0.6, 0.0));
+        let points = wall_points(&camera);
+        let pose = Some(camera.world_from_camera);
+        assert_eq!(
+            inline.observe(&points, pose, true),
+            worker.observe(&points, pose, true)
+        );
+        let (a, b) = (inline.map(), worker.map());
+        assert_eq!(a.num_keyframes(), b.num_keyframes(), "frame {step}");
+        for x in -10..=10 {
+            for z in -10..=10 {
+                let p = Vec3::new(0.1 * x as f32, 0.5, 0.1 * z as f32);
+                assert_eq!(a.is_free(p), b.is_free(p), "frame {step}, {p}");
+            }
+        }
+    }
+    assert_eq!(inline.map().num_keyframes(), 4, "keyframes due by frame 40");
 }
