@@ -16,9 +16,12 @@
 use glam::{Affine3A, Mat4, Quat, Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 use sylva_core::environment::{Scene, SceneMode};
+use sylva_tracking::depth_mesh::Observation;
 use sylva_tracking::occupancy::OccupancyMap;
 
-use crate::render::{GroundPlane, OccluderMesh, ViewCamera};
+use crate::render::{GroundPlane, Intrinsics, OccluderMesh, ViewCamera};
+use crate::scene_tracking::SceneOccupancy;
+use crate::state::{DesignState, PICK_RADIUS_PX};
 
 /// How growth reacts to the tracked scene (the UI's "scene" control; recorded with the
 /// parameters).
@@ -138,6 +141,112 @@ impl Scene for TreeScene<'_> {
             || self
                 .map
                 .is_free(self.world_from_tree.transform_point3(point_in_tree))
+    }
+}
+
+/// The scene growth reacts to in `choice`, in tree space (None for free growth or without a
+/// map).
+pub(crate) fn growth_scene(
+    choice: SceneChoice,
+    occupancy: &Option<SceneOccupancy>,
+    world_from_tree: Option<Affine3A>,
+) -> Option<(TreeScene<'_>, SceneMode)> {
+    Some((tree_scene(occupancy, world_from_tree)?, choice.mode()?))
+}
+
+/// The tracked scene in tree space, when the tree is planted and a map exists.
+pub(crate) fn tree_scene(
+    occupancy: &Option<SceneOccupancy>,
+    world_from_tree: Option<Affine3A>,
+) -> Option<TreeScene<'_>> {
+    let map = occupancy.as_ref()?.map();
+    (map.num_keyframes() > 0).then_some(TreeScene {
+        map,
+        world_from_tree: world_from_tree?,
+        ground_clearance_m: sylva_tracking::occupancy::OccupancyConfig::default().voxel_size_m,
+    })
+}
+
+/// Planting and the scene, for the design state.
+impl DesignState {
+    /// Takes the scene of the frame about to be shown: its ground plane and, once the ground is
+    /// found, its tracked points for the occupancy of the scene (call before
+    /// [`Self::advance_frame`]).
+    pub fn observe_scene(
+        &mut self,
+        intrinsics: &Intrinsics,
+        world_from_camera: Option<Mat4>,
+        ground: Option<GroundPlane>,
+        observations: &[Observation],
+    ) {
+        self.ground = ground;
+        self.occupancy
+            .get_or_insert_with(|| SceneOccupancy::new(intrinsics))
+            .observe(observations, world_from_camera, ground.is_some());
+    }
+
+    /// Builds the scene's occupancy on a worker thread (the window; replays build the same map
+    /// inline, at the same frames).
+    pub fn with_scene_worker(mut self, intrinsics: &Intrinsics) -> DesignState {
+        self.occupancy = Some(SceneOccupancy::with_worker(intrinsics));
+        self
+    }
+
+    /// The camera in the world (the tracked pose of the frame shown).
+    pub fn world_camera(&self) -> Option<ViewCamera> {
+        self.world_camera
+    }
+
+    /// Tree space from the world (identity before planting).
+    pub fn tree_from_world(&self) -> Affine3A {
+        self.world_from_tree.unwrap_or(Affine3A::IDENTITY).inverse()
+    }
+
+    /// Whether the tree is planted (shown and editable).
+    pub fn is_planted(&self) -> bool {
+        self.world_from_tree.is_some()
+    }
+
+    /// Number of keyframes in the occupancy of the scene.
+    pub fn num_scene_keyframes(&self) -> usize {
+        self.occupancy
+            .as_ref()
+            .map_or(0, |o| o.map().num_keyframes())
+    }
+
+    pub(crate) fn update_tree_camera(&mut self) {
+        let tree_from_world = self.tree_from_world();
+        self.camera = self
+            .world_camera
+            .filter(|_| self.is_planted())
+            .map(|c| camera_in_tree(&c, &tree_from_world));
+    }
+
+    /// Plants (or moves) the tree where the ray through `pixel` meets the ground plane; false
+    /// when there is no camera or ground yet, or the ray misses the ground.
+    pub(crate) fn plant_at(&mut self, pixel: Vec2) -> bool {
+        let (Some(camera), Some(ground)) = (self.world_camera, self.ground) else {
+            return false;
+        };
+        let Some(point) = ground_point_at_pixel(&camera, &ground, pixel) else {
+            return false;
+        };
+        self.world_from_tree = Some(world_from_tree_at(point, &ground));
+        self.update_tree_camera();
+        self.changed();
+        true
+    }
+
+    /// A touch starting on the trunk base drags the tree.
+    pub(crate) fn begin_move(&mut self, id: u64, pixel: Vec2) -> bool {
+        let on_base = self
+            .camera
+            .and_then(|c| c.pixel_from_world(Vec3::ZERO))
+            .is_some_and(|base| base.distance(pixel) <= PICK_RADIUS_PX);
+        if on_base {
+            self.moving_base = Some(id);
+        }
+        on_base
     }
 }
 

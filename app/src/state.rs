@@ -11,7 +11,7 @@
 
 use std::collections::BTreeMap;
 
-use glam::{Affine3A, Mat4, Quat, Vec2, Vec3};
+use glam::{Affine3A, Quat, Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 use sylva_core::edit::{
     Bend, BendSettings, BrushPlane, BrushSettings, BrushStroke, History, OperationKind,
@@ -20,12 +20,9 @@ use sylva_core::edit::{
 use sylva_core::environment::{Scene, SceneMode};
 use sylva_core::species::Species;
 use sylva_core::{NodeId, Tree};
-use sylva_tracking::depth_mesh::Observation;
 
-use crate::planting::{
-    SceneChoice, TreeScene, camera_in_tree, ground_point_at_pixel, world_from_tree_at,
-};
-use crate::render::{GroundPlane, Intrinsics, ViewCamera};
+use crate::planting::{SceneChoice, growth_scene, tree_scene};
+use crate::render::{GroundPlane, ViewCamera};
 use crate::scene_tracking::SceneOccupancy;
 
 /// Growth and brush parameters the UI exposes.
@@ -226,7 +223,7 @@ struct Touch {
 const TAP_SLOP_PX: f32 = 8.0;
 const DOUBLE_TAP_S: f64 = 0.35;
 const HOLD_S: f64 = 0.5;
-const PICK_RADIUS_PX: f32 = 25.0;
+pub(crate) const PICK_RADIUS_PX: f32 = 25.0;
 
 /// A three-finger bend in progress: the branch from `base` to its tip `end`, rotated about the
 /// start of `base` by `angle` radians about the view direction.
@@ -257,15 +254,15 @@ pub struct DesignState {
     /// the brush and gestures work in tree space.
     pub camera: Option<ViewCamera>,
     /// The camera in the world.
-    world_camera: Option<ViewCamera>,
+    pub(crate) world_camera: Option<ViewCamera>,
     /// The ground plane in the world, once found.
     pub ground: Option<GroundPlane>,
     /// Where the tree stands in the world; None until a tap on the ground plants it.
     pub world_from_tree: Option<Affine3A>,
     /// The touch dragging the trunk base (moving the tree).
-    moving_base: Option<u64>,
+    pub(crate) moving_base: Option<u64>,
     /// The occupancy of the tracked scene (from the first frame with tracked points).
-    occupancy: Option<SceneOccupancy>,
+    pub(crate) occupancy: Option<SceneOccupancy>,
     pub time_s: f64,
     /// Bumped whenever the tree changes (the renderer re-meshes on change).
     pub revision: u64,
@@ -288,29 +285,6 @@ fn move_to_iteration(
         timeline.keep(tree);
     }
     Ok(())
-}
-
-/// The scene growth reacts to in `choice`, in tree space (None for free growth or without a
-/// map).
-fn growth_scene(
-    choice: SceneChoice,
-    occupancy: &Option<SceneOccupancy>,
-    world_from_tree: Option<Affine3A>,
-) -> Option<(TreeScene<'_>, SceneMode)> {
-    Some((tree_scene(occupancy, world_from_tree)?, choice.mode()?))
-}
-
-/// The tracked scene in tree space, when the tree is planted and a map exists.
-fn tree_scene(
-    occupancy: &Option<SceneOccupancy>,
-    world_from_tree: Option<Affine3A>,
-) -> Option<TreeScene<'_>> {
-    let map = occupancy.as_ref()?.map();
-    (map.num_keyframes() > 0).then_some(TreeScene {
-        map,
-        world_from_tree: world_from_tree?,
-        ground_clearance_m: sylva_tracking::occupancy::OccupancyConfig::default().voxel_size_m,
-    })
 }
 
 /// Autonomous iterations of the sapling a design starts from: a trunk with a few laterals to
@@ -375,7 +349,7 @@ impl DesignState {
         self.history.num_undoable()
     }
 
-    fn changed(&mut self) {
+    pub(crate) fn changed(&mut self) {
         self.revision += 1;
     }
 
@@ -404,86 +378,6 @@ impl DesignState {
                 self.grow_once();
             }
         }
-    }
-
-    /// Takes the scene of the frame about to be shown: its ground plane and, once the ground is
-    /// found, its tracked points for the occupancy of the scene (call before
-    /// [`Self::advance_frame`]).
-    pub fn observe_scene(
-        &mut self,
-        intrinsics: &Intrinsics,
-        world_from_camera: Option<Mat4>,
-        ground: Option<GroundPlane>,
-        observations: &[Observation],
-    ) {
-        self.ground = ground;
-        self.occupancy
-            .get_or_insert_with(|| SceneOccupancy::new(intrinsics))
-            .observe(observations, world_from_camera, ground.is_some());
-    }
-
-    /// Builds the scene's occupancy on a worker thread (the window; replays build the same map
-    /// inline, at the same frames).
-    pub fn with_scene_worker(mut self, intrinsics: &Intrinsics) -> DesignState {
-        self.occupancy = Some(SceneOccupancy::with_worker(intrinsics));
-        self
-    }
-
-    /// The camera in the world (the tracked pose of the frame shown).
-    pub fn world_camera(&self) -> Option<ViewCamera> {
-        self.world_camera
-    }
-
-    /// Tree space from the world (identity before planting).
-    pub fn tree_from_world(&self) -> Affine3A {
-        self.world_from_tree.unwrap_or(Affine3A::IDENTITY).inverse()
-    }
-
-    /// Whether the tree is planted (shown and editable).
-    pub fn is_planted(&self) -> bool {
-        self.world_from_tree.is_some()
-    }
-
-    /// Number of keyframes in the occupancy of the scene.
-    pub fn num_scene_keyframes(&self) -> usize {
-        self.occupancy
-            .as_ref()
-            .map_or(0, |o| o.map().num_keyframes())
-    }
-
-    fn update_tree_camera(&mut self) {
-        let tree_from_world = self.tree_from_world();
-        self.camera = self
-            .world_camera
-            .filter(|_| self.is_planted())
-            .map(|c| camera_in_tree(&c, &tree_from_world));
-    }
-
-    /// Plants (or moves) the tree where the ray through `pixel` meets the ground plane; false
-    /// when there is no camera or ground yet, or the ray misses the ground.
-    fn plant_at(&mut self, pixel: Vec2) -> bool {
-        let (Some(camera), Some(ground)) = (self.world_camera, self.ground) else {
-            return false;
-        };
-        let Some(point) = ground_point_at_pixel(&camera, &ground, pixel) else {
-            return false;
-        };
-        self.world_from_tree = Some(world_from_tree_at(point, &ground));
-        self.update_tree_camera();
-        self.changed();
-        true
-    }
-
-    /// A touch starting on the trunk base drags the tree.
-    fn begin_move(&mut self, id: u64, pixel: Vec2) -> bool {
-        let on_base = self
-            .camera
-            .and_then(|c| c.pixel_from_world(Vec3::ZERO))
-            .is_some_and(|base| base.distance(pixel) <= PICK_RADIUS_PX);
-        if on_base {
-            self.moving_base = Some(id);
-        }
-        on_base
     }
 
     /// One brush-guided growth iteration towards the persistent points of the stroke.
