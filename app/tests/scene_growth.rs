@@ -15,9 +15,12 @@
 //!
 //! Run: `cargo test --release -p sylva-app --test scene_growth`
 
+mod garden_truth;
+
 use std::path::{Path, PathBuf};
 
-use glam::{Affine3A, DAffine3, DQuat, DVec3, Vec3};
+use garden_truth::{root, true_poses, truth_from_tracked};
+use glam::{Affine3A, Vec3};
 use serde::{Deserialize, Serialize};
 use sylva_app::demo_script::{scripted_session, tap};
 use sylva_app::footage::Footage;
@@ -26,8 +29,6 @@ use sylva_app::render::ViewCamera;
 use sylva_app::session::{Session, replay};
 use sylva_app::state::{DesignState, InputEvent, Parameters};
 use sylva_core::species::Species;
-use sylva_tracking::linalg::Similarity;
-use sylva_tracking::metrics::{PosePair, align_frames};
 use sylva_tracking::occupancy::OccupancyConfig;
 
 /// Where the user taps: 0.25 m from the box's left face, level with its middle (true world).
@@ -40,59 +41,15 @@ const GROW_FRAMES: [usize; 8] = [60, 80, 100, 120, 140, 160, 180, 200];
 const PRUNE_FRAME: usize = 225;
 const SPECIES: &str = "norway_spruce";
 
-fn root() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../test-data/demo_garden")
-}
-
 fn sessions_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/sessions")
 }
 
-/// The generator's `world_from_camera` of every frame, in the footage's order.
-fn true_poses(root: &Path) -> Vec<DAffine3> {
-    let text = std::fs::read_to_string(root.join("groundtruth.txt")).expect("groundtruth.txt");
-    text.lines()
-        .filter(|l| !l.starts_with('#') && !l.trim().is_empty())
-        .map(|l| {
-            let v: Vec<f64> = l
-                .split_whitespace()
-                .skip(1)
-                .map(|x| x.parse().expect("number"))
-                .collect();
-            DAffine3::from_rotation_translation(
-                DQuat::from_xyzw(v[3], v[4], v[5], v[6]).normalize(),
-                DVec3::new(v[0], v[1], v[2]),
-            )
-        })
-        .collect()
-}
-
-#[derive(Deserialize)]
-struct Block {
-    name: String,
-    min: [f32; 3],
-    max: [f32; 3],
-}
-
-#[derive(Deserialize)]
-struct SceneFile {
-    blocks: Vec<Block>,
-}
-
 /// The generator's true solids (wall, box), each shrunk by `margin_m`.
-fn true_blocks(root: &Path, margin_m: f32) -> Vec<(String, Vec3, Vec3)> {
-    let text = std::fs::read_to_string(root.join("scene.json")).expect("scene.json");
-    let scene: SceneFile = serde_json::from_str(&text).expect("scene.json parses");
-    scene
-        .blocks
+fn true_blocks(margin_m: f32) -> Vec<(String, Vec3, Vec3)> {
+    garden_truth::true_blocks()
         .into_iter()
-        .map(|b| {
-            (
-                b.name,
-                Vec3::from(b.min) + margin_m,
-                Vec3::from(b.max) - margin_m,
-            )
-        })
+        .map(|(name, min, max)| (name, min + margin_m, max - margin_m))
         .collect()
 }
 
@@ -101,7 +58,7 @@ fn script(
     prune_at_end: bool,
 ) -> impl FnMut(usize, &DesignState) -> Vec<InputEvent> {
     let footage = Footage::open(&root()).expect("demo footage");
-    let truth = true_poses(&root());
+    let truth = true_poses();
     move |step, state| {
         let mut events = Vec::new();
         if step == TAP_FRAME + 1 {
@@ -153,27 +110,14 @@ struct Outcome {
 
 fn replay_against_truth(session_path: &Path, margin_m: f32) -> Outcome {
     let session = Session::load(session_path).expect("committed session");
-    let truth = true_poses(&root());
-    let pairs: Vec<PosePair> = session
-        .frames
-        .iter()
-        .filter_map(|f| {
-            let m = glam::Mat4::from_cols_array(f.world_from_camera.as_ref()?);
-            Some(PosePair {
-                index: f.index,
-                estimated: DAffine3::from_mat4(m.as_dmat4()),
-                truth: truth[f.index],
-            })
-        })
-        .collect();
-    let truth_from_tracked: Similarity = align_frames(&pairs).expect("alignment");
+    let (truth_from_tracked, num_posed) = truth_from_tracked(&session);
     println!(
         "{}: {} posed frames, tracked world scale ×{:.3} to the truth",
         session_path.display(),
-        pairs.len(),
+        num_posed,
         truth_from_tracked.scale
     );
-    let blocks = true_blocks(&root(), margin_m);
+    let blocks = true_blocks(margin_m);
     let to_truth = |p: Vec3| truth_from_tracked.transform_point(p.as_dvec3()).as_vec3();
     let inside_count = |state: &DesignState, world_from_tree: Affine3A| {
         state
