@@ -49,21 +49,63 @@ impl SceneMesher {
         }
     }
 
-    /// Updates the mesh with one frame's observations and returns it in the world.
+    /// Updates the mesh with one frame's observations and returns it in the world, filled down
+    /// to the ground contact once the ground is known ([`skirt_to_ground`]).
     pub fn update(
         &mut self,
         observations: &[Observation],
         world_from_camera: Mat4,
+        ground: Option<GroundPlane>,
     ) -> OccluderMesh {
         self.depth_mesh.update(observations);
         let mesh = self
             .depth_mesh
             .export_camera_space()
             .to_world(&Affine3A::from_mat4(world_from_camera));
-        OccluderMesh {
+        let mut occluder = OccluderMesh {
             positions: mesh.positions,
             indices: mesh.indices,
+        };
+        if let Some(ground) = ground {
+            skirt_to_ground(&mut occluder, &ground);
         }
+        occluder
+    }
+}
+
+/// Edges of the mesh's open boundary higher than this above the ground get a skirt (m).
+const MIN_SKIRT_HEIGHT_M: f32 = 0.03;
+
+/// Fills the occluder down to the ground contact: every open boundary edge of the mesh above
+/// the ground gets a quad straight down to the plane. The depth mesh leaves the faces under an
+/// object's top and edges open (triangles across a depth discontinuity are unknown, and few
+/// points are tracked on a plain face); garden objects (walls, boxes, planters) are solid down to
+/// the ground, so what is seen of their top hides everything behind them below it.
+pub fn skirt_to_ground(occluder: &mut OccluderMesh, ground: &GroundPlane) {
+    let mut edge_count: std::collections::BTreeMap<(u32, u32), u32> = Default::default();
+    for triangle in occluder.indices.chunks_exact(3) {
+        for k in 0..3 {
+            let (a, b) = (triangle[k], triangle[(k + 1) % 3]);
+            *edge_count.entry((a.min(b), a.max(b))).or_default() += 1;
+        }
+    }
+    let height = |p: Vec3| (p - ground.point).dot(ground.normal);
+    for ((a, b), count) in edge_count {
+        if count != 1 {
+            continue;
+        }
+        let (pa, pb) = (
+            occluder.positions[a as usize],
+            occluder.positions[b as usize],
+        );
+        let (ha, hb) = (height(pa), height(pb));
+        if ha.max(hb) < MIN_SKIRT_HEIGHT_M || ha < 0.0 || hb < 0.0 {
+            continue;
+        }
+        let base = occluder.positions.len() as u32;
+        occluder.positions.push(pa - ground.normal * ha);
+        occluder.positions.push(pb - ground.normal * hb);
+        occluder.indices.extend([a, b, base + 1, a, base + 1, base]);
     }
 }
 
@@ -330,7 +372,7 @@ mod desktop {
                     })
                 })
                 .collect();
-            let occluder = self.mesher.update(&observations, world_from_camera);
+            let occluder = self.mesher.update(&observations, world_from_camera, ground);
             SceneFrame {
                 world_from_camera: Some(world_from_camera),
                 ground,
@@ -438,5 +480,39 @@ impl SceneTracker {
         self.frames
             .get(index)
             .ok_or_else(|| anyhow::anyhow!("no tracked frame {index}"))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_skirt_drops_every_open_edge_above_the_ground_down_to_it() {
+        // A box top seen alone: one triangle 0.5 m above the ground, and one on the ground.
+        let mut occluder = OccluderMesh {
+            positions: vec![
+                Vec3::new(0.0, 0.5, 0.0),
+                Vec3::new(1.0, 0.5, 0.0),
+                Vec3::new(0.0, 0.5, 1.0),
+                Vec3::new(3.0, 0.0, 0.0),
+                Vec3::new(4.0, 0.01, 0.0),
+                Vec3::new(3.0, 0.0, 1.0),
+            ],
+            indices: vec![0, 1, 2, 3, 4, 5],
+        };
+        skirt_to_ground(&mut occluder, &GroundPlane::default());
+        assert_eq!(
+            occluder.indices.len(),
+            6 + 3 * 6,
+            "one quad per edge of the top"
+        );
+        assert_eq!(occluder.positions.len(), 6 + 3 * 2);
+        for p in &occluder.positions[6..] {
+            assert!(
+                p.y.abs() < 1e-6 && p.x < 1.5,
+                "skirt foot {p} on the ground below the top"
+            );
+        }
     }
 }

@@ -345,7 +345,11 @@ pub fn replay(
         // The frame is drawn in tree space (the tree's mesh is): camera, occluder and ground
         // moved by tree_from_world.
         let tree_from_world = state.tree_from_world();
-        let occluder = mesher.update(&record.observations(), camera.world_from_camera);
+        let occluder = mesher.update(
+            &record.observations(),
+            camera.world_from_camera,
+            record.ground_plane(),
+        );
         renderer.set_occluder(gpu, &occluder_in_tree(&occluder, &tree_from_world));
         let ground = record
             .ground_plane()

@@ -111,7 +111,11 @@ fn the_tracked_occluder_hides_a_tree_planted_behind_the_box_where_the_true_box_d
             continue;
         };
         // The occluder as the replay builds it: every frame's observations, in order.
-        let occluder = mesher.update(&record.observations(), camera.world_from_camera);
+        let occluder = mesher.update(
+            &record.observations(),
+            camera.world_from_camera,
+            record.ground_plane(),
+        );
         let Some((_, tree, world_from_tree)) = shown.iter().find(|s| s.0 == step) else {
             continue;
         };
