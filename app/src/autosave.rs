@@ -83,6 +83,8 @@ impl Autosaver {
             .tree
             .save(&self.tree_path)
             .with_context(|| format!("cannot autosave the tree to {}", self.tree_path.display()))?;
+        // The tree file is in tree space; where it stands goes beside it.
+        crate::player::write_placement(design, &self.tree_path.with_extension("placement.json"))?;
         if let Some(path) = &self.session_path {
             session.save(path)?;
         }

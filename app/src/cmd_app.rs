@@ -43,6 +43,10 @@ pub struct ViewArgs {
     /// Start in the 3D view outside AR (orbit, pan, zoom) instead of the camera view.
     #[arg(long)]
     pub orbit: bool,
+    /// Plant the tree at the world origin as soon as the ground is found (a tap there, recorded
+    /// in the session) instead of waiting for the user's tap.
+    #[arg(long)]
+    pub plant_at_origin: bool,
 }
 
 /// Finds the demo sequence from the current folder or the workspace the binary was built in.
@@ -102,6 +106,7 @@ struct WindowStart {
     frame: usize,
     paused: bool,
     orbit: bool,
+    plant_at_origin: bool,
 }
 
 fn open_window(sequence: &Path, start: WindowStart) -> anyhow::Result<()> {
@@ -109,13 +114,9 @@ fn open_window(sequence: &Path, start: WindowStart) -> anyhow::Result<()> {
     std::fs::create_dir_all("out").context("cannot create out/")?;
     let session_path = PathBuf::from("out/last-session.json");
     let footage_ref = std::fs::canonicalize(sequence).unwrap_or_else(|_| sequence.to_owned());
-    crate::desktop::run_window(
-        crate::player::Player::new(footage, footage_ref)?,
-        session_path,
-        start.frame,
-        start.paused,
-        start.orbit,
-    )
+    let mut player = crate::player::Player::new(footage, footage_ref)?;
+    player.plant_at_origin = start.plant_at_origin;
+    crate::desktop::run_window(player, session_path, start.frame, start.paused, start.orbit)
 }
 
 /// What `sylva view` plays.
@@ -180,6 +181,7 @@ pub fn view(args: ViewArgs) -> anyhow::Result<()> {
             frame: args.frame,
             paused: args.paused,
             orbit: args.orbit,
+            plant_at_origin: args.plant_at_origin,
         },
     )
 }
@@ -216,7 +218,8 @@ pub fn stream_player(
 
 #[cfg(not(any(target_os = "android", target_os = "ios")))]
 fn open_stream(input: StreamSource, args: &ViewArgs) -> anyhow::Result<()> {
-    let (player, session_path) = stream_player(input, args)?;
+    let (mut player, session_path) = stream_player(input, args)?;
+    player.plant_at_origin = args.plant_at_origin;
     if let Some(dir) = args.record.as_ref() {
         eprintln!("recording the frames shown into {}", dir.display());
     }

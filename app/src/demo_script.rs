@@ -1,6 +1,8 @@
-//! The scripted demo session on the bundled sequence: two brush strokes, a prune (double tap) and
-//! a bend (three touches), aimed at the tree as it is when each gesture happens. It is both the
-//! headless demo and the committed session that CI replays.
+//! The scripted demo session on the bundled sequence: a tap on the ground that plants the tree,
+//! two brush strokes, a prune (double tap) and a bend (three touches), aimed at the tree as it
+//! is when each gesture happens. It is both the headless demo and the committed session that CI
+//! replays. [`scripted_session`] runs any such script through the tracker and the design state
+//! exactly as the app does (the scene sessions of the tests use it too).
 
 use std::path::PathBuf;
 
@@ -21,111 +23,37 @@ fn touch(phase: TouchPhase, id: u64, p: Vec2) -> InputEvent {
     }
 }
 
-/// Builds the demo session over every frame of `footage` (referenced as `footage_ref`).
-pub fn demo_session(footage: &Footage, footage_ref: PathBuf) -> anyhow::Result<Session> {
-    let params = Parameters::default();
+/// Records a session over every frame of `footage` (referenced as `footage_ref`): before each
+/// frame, `script(step, state)` says what the user does, seeing the design as it is then (the
+/// camera of the frame shown before); the events are applied and recorded, then the frame is
+/// tracked, observed and shown, as the player does.
+pub fn scripted_session(
+    footage: &Footage,
+    footage_ref: PathBuf,
+    params: Parameters,
+    mut script: impl FnMut(usize, &DesignState) -> Vec<InputEvent>,
+) -> anyhow::Result<Session> {
     let mut session = Session::new(footage_ref, DEFAULT_SEED, params.clone());
-    let mut state = DesignState::new(DEFAULT_SEED, params.clone());
+    let mut state = session.initial_design();
     let mut previous_time = footage.frames.first().map_or(0.0, |f| f.time_s);
-    let n = footage.len();
-    let at = |fraction: f32| (fraction * n as f32) as usize;
-    let mut stroke_pixel = Vec2::ZERO;
-    let mut bend_pixel = Vec2::ZERO;
     let mut tracker = SceneTracker::open(&footage.root, footage.intrinsics)?;
-    for index in 0..n {
-        let step = index;
-        let mut events = Vec::new();
-        let top_pixel = state.camera.and_then(|c| {
-            let top = state
-                .tree
-                .skeleton
-                .internodes
-                .iter()
-                .map(|i| i.end)
-                .fold(glam::Vec3::ZERO, |a, b| if b.y > a.y { b } else { a });
-            c.pixel_from_world(top)
-        });
-        // Stroke 1: from the top of the seedling, up and to the right.
-        if step == at(0.1) {
-            if let Some(p) = top_pixel {
-                stroke_pixel = p;
-                events.push(touch(TouchPhase::Start, 0, p));
-            }
-        } else if step > at(0.1) && step < at(0.3) {
-            stroke_pixel += Vec2::new(3.0, -5.0);
-            events.push(touch(TouchPhase::Move, 0, stroke_pixel));
-        } else if step == at(0.3) {
-            events.push(touch(TouchPhase::End, 0, stroke_pixel));
-        }
-        // Stroke 2: from the top again, first straight up (inside the top bud's perception
-        // cone), then curving to the left, with a wider brush half way.
-        if step == at(0.35)
-            && let Some(p) = top_pixel
-        {
-            stroke_pixel = p;
-            events.push(touch(TouchPhase::Start, 0, p));
-        } else if step > at(0.35) && step < at(0.55) {
-            let turn = (step - at(0.35)) as f32 / (at(0.55) - at(0.35)) as f32;
-            stroke_pixel += Vec2::new(-6.0 * turn, -5.0 * (1.0 - 0.5 * turn));
-            events.push(touch(TouchPhase::Move, 0, stroke_pixel));
-            if step == at(0.45) {
-                let mut p = state.params.clone();
-                p.brush_radius *= 1.6;
-                events.push(InputEvent::Parameters { parameters: p });
-            }
-        } else if step == at(0.55) {
-            events.push(touch(TouchPhase::End, 0, stroke_pixel));
-        }
-        // Prune: double tap on the newest branch.
-        if (step == at(0.62) || step == at(0.62) + 1)
-            && let (Some(camera), Some(newest)) =
-                (state.camera, state.tree.skeleton.internodes.last())
-            && let Some(p) = camera.pixel_from_world(0.5 * (newest.start + newest.end))
-        {
-            events.push(touch(TouchPhase::Start, 0, p));
-            events.push(touch(TouchPhase::End, 0, p));
-        }
-        // Bend: three fingers around a branch half way up, dragged to the right.
-        if step == at(0.7)
-            && let Some(camera) = state.camera
-            && let Some(node) = state
-                .tree
-                .skeleton
-                .internodes
-                .get(state.tree.skeleton.len() / 2)
-            && let Some(p) = camera.pixel_from_world(node.end)
-        {
-            bend_pixel = p;
-            for (id, offset) in [
-                (1, Vec2::new(-10.0, 0.0)),
-                (2, Vec2::new(10.0, 0.0)),
-                (3, Vec2::new(0.0, 10.0)),
-            ] {
-                events.push(touch(TouchPhase::Start, id, p + offset));
-            }
-        } else if step > at(0.7) && step < at(0.8) {
-            bend_pixel.x += 3.0;
-            for (id, offset) in [
-                (1, Vec2::new(-10.0, 0.0)),
-                (2, Vec2::new(10.0, 0.0)),
-                (3, Vec2::new(0.0, 10.0)),
-            ] {
-                events.push(touch(TouchPhase::Move, id, bend_pixel + offset));
-            }
-        } else if step == at(0.8) {
-            for id in 1..=3 {
-                events.push(touch(TouchPhase::End, id, bend_pixel));
-            }
-        }
-        for e in events {
+    for index in 0..footage.len() {
+        for e in script(index, &state) {
             state.apply(&e);
             session.record(e);
         }
-        session.push_frame(footage, index, tracker.frame(index)?);
+        let scene = tracker.frame(index)?;
+        session.push_frame(footage, index, scene);
         let Some(record) = session.frames.last() else {
             continue;
         };
         let camera = frame_camera(record, footage);
+        state.observe_scene(
+            &footage.intrinsics,
+            camera.map(|c| c.world_from_camera),
+            record.ground_plane(),
+            &record.observations(),
+        );
         state.advance_frame(
             camera,
             record.time_s,
@@ -134,4 +62,119 @@ pub fn demo_session(footage: &Footage, footage_ref: PathBuf) -> anyhow::Result<S
         previous_time = record.time_s;
     }
     Ok(session)
+}
+
+/// A tap (touch 0 down and up at once) at `pixel`.
+pub fn tap(pixel: Vec2) -> [InputEvent; 2] {
+    [
+        touch(TouchPhase::Start, 0, pixel),
+        touch(TouchPhase::End, 0, pixel),
+    ]
+}
+
+/// Builds the demo session over every frame of `footage` (referenced as `footage_ref`).
+pub fn demo_session(footage: &Footage, footage_ref: PathBuf) -> anyhow::Result<Session> {
+    let n = footage.len();
+    let at = |fraction: f32| (fraction * n as f32) as usize;
+    let mut stroke_pixel = Vec2::ZERO;
+    let mut bend_pixel = Vec2::ZERO;
+    scripted_session(
+        footage,
+        footage_ref,
+        Parameters::default(),
+        |step, state| {
+            let mut events = Vec::new();
+            // Plant: a tap on the ground at the world origin's pixel once the ground is found.
+            if !state.is_planted()
+                && state.ground.is_some()
+                && let Some(camera) = state.world_camera()
+                && let Some(p) = camera.pixel_from_world(glam::Vec3::ZERO)
+            {
+                events.extend(tap(p));
+            }
+            let top_pixel = state.camera.and_then(|c| {
+                let top = state
+                    .tree
+                    .skeleton
+                    .internodes
+                    .iter()
+                    .map(|i| i.end)
+                    .fold(glam::Vec3::ZERO, |a, b| if b.y > a.y { b } else { a });
+                c.pixel_from_world(top)
+            });
+            // Stroke 1: from the top of the seedling, up and to the right.
+            if step == at(0.1) {
+                if let Some(p) = top_pixel {
+                    stroke_pixel = p;
+                    events.push(touch(TouchPhase::Start, 0, p));
+                }
+            } else if step > at(0.1) && step < at(0.3) {
+                stroke_pixel += Vec2::new(3.0, -5.0);
+                events.push(touch(TouchPhase::Move, 0, stroke_pixel));
+            } else if step == at(0.3) {
+                events.push(touch(TouchPhase::End, 0, stroke_pixel));
+            }
+            // Stroke 2: from the top again, first straight up (inside the top bud's perception
+            // cone), then curving to the left, with a wider brush half way.
+            if step == at(0.35)
+                && let Some(p) = top_pixel
+            {
+                stroke_pixel = p;
+                events.push(touch(TouchPhase::Start, 0, p));
+            } else if step > at(0.35) && step < at(0.55) {
+                let turn = (step - at(0.35)) as f32 / (at(0.55) - at(0.35)) as f32;
+                stroke_pixel += Vec2::new(-6.0 * turn, -5.0 * (1.0 - 0.5 * turn));
+                events.push(touch(TouchPhase::Move, 0, stroke_pixel));
+                if step == at(0.45) {
+                    let mut p = state.params.clone();
+                    p.brush_radius *= 1.6;
+                    events.push(InputEvent::Parameters { parameters: p });
+                }
+            } else if step == at(0.55) {
+                events.push(touch(TouchPhase::End, 0, stroke_pixel));
+            }
+            // Prune: double tap on the newest branch.
+            if (step == at(0.62) || step == at(0.62) + 1)
+                && let (Some(camera), Some(newest)) =
+                    (state.camera, state.tree.skeleton.internodes.last())
+                && let Some(p) = camera.pixel_from_world(0.5 * (newest.start + newest.end))
+            {
+                events.push(touch(TouchPhase::Start, 0, p));
+                events.push(touch(TouchPhase::End, 0, p));
+            }
+            // Bend: three fingers around a branch half way up, dragged to the right.
+            if step == at(0.7)
+                && let Some(camera) = state.camera
+                && let Some(node) = state
+                    .tree
+                    .skeleton
+                    .internodes
+                    .get(state.tree.skeleton.len() / 2)
+                && let Some(p) = camera.pixel_from_world(node.end)
+            {
+                bend_pixel = p;
+                for (id, offset) in [
+                    (1, Vec2::new(-10.0, 0.0)),
+                    (2, Vec2::new(10.0, 0.0)),
+                    (3, Vec2::new(0.0, 10.0)),
+                ] {
+                    events.push(touch(TouchPhase::Start, id, p + offset));
+                }
+            } else if step > at(0.7) && step < at(0.8) {
+                bend_pixel.x += 3.0;
+                for (id, offset) in [
+                    (1, Vec2::new(-10.0, 0.0)),
+                    (2, Vec2::new(10.0, 0.0)),
+                    (3, Vec2::new(0.0, 10.0)),
+                ] {
+                    events.push(touch(TouchPhase::Move, id, bend_pixel + offset));
+                }
+            } else if step == at(0.8) {
+                for id in 1..=3 {
+                    events.push(touch(TouchPhase::End, id, bend_pixel));
+                }
+            }
+            events
+        },
+    )
 }

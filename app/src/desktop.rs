@@ -35,7 +35,7 @@ struct DesktopApp {
     /// The camera of the 3D view outside AR (framed on the tree when the view opens).
     orbit: Option<crate::ui::orbit::OrbitCamera>,
     /// Footage frame whose image and occluder the renderer holds.
-    uploaded_frame: Option<usize>,
+    uploaded_frame: Option<(usize, Option<glam::Affine3A>)>,
     started: Instant,
     session_path: PathBuf,
     autosaver: crate::autosave::Autosaver,
@@ -239,12 +239,12 @@ impl DesktopApp {
                 size,
                 &FrameView::tree_only(camera),
             );
-        } else if let Some(camera) = self.player.camera() {
-            let revision =
-                Some(self.player.design.revision).filter(|_| self.player.ui.ground_found);
+        } else if let Some(camera) = self.player.camera_in_tree() {
+            // The frame is drawn in tree space (the tree's mesh is), after planting.
+            let revision = Some(self.player.design.revision)
+                .filter(|_| self.player.ui.ground_found && self.player.design.is_planted());
             if self.meshed_revision != revision {
                 let t = Instant::now();
-                // The seedling is planted once the ground is found.
                 match revision {
                     Some(_) => gfx
                         .renderer
@@ -255,7 +255,8 @@ impl DesktopApp {
                 self.meshed_revision = revision;
             }
             // The footage image and the occluder change with the shown frame, not per redraw.
-            if self.uploaded_frame != Some(self.player.frame) {
+            let placed = (self.player.frame, self.player.design.world_from_tree);
+            if self.uploaded_frame != Some(placed) {
                 if let Some(image) = &self.player.image {
                     gfx.renderer.set_camera_image(
                         &gfx.gpu,
@@ -264,11 +265,15 @@ impl DesktopApp {
                     );
                 }
                 if let Some(scene) = self.player.scene() {
-                    gfx.renderer.set_occluder(&gfx.gpu, &scene.occluder);
+                    let occluder = crate::planting::occluder_in_tree(
+                        &scene.occluder,
+                        &self.player.design.tree_from_world(),
+                    );
+                    gfx.renderer.set_occluder(&gfx.gpu, &occluder);
                 }
-                self.uploaded_frame = Some(self.player.frame);
+                self.uploaded_frame = Some(placed);
             }
-            let mut view = FrameView::augmented(camera, self.player.ground());
+            let mut view = FrameView::augmented(camera, self.player.ground_in_tree());
             view.debug.depth_wireframe = self.player.ui.show_debug;
             view.debug.brush = self.player.brush_sphere();
             gfx.renderer

@@ -14,6 +14,7 @@ pub mod footage;
 pub mod live;
 #[cfg(not(any(target_os = "android", target_os = "ios")))]
 pub mod live_capture;
+pub mod planting;
 pub mod player;
 pub mod render;
 pub mod scale;

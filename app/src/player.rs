@@ -13,7 +13,7 @@ use crate::live::{FootageRecorder, LiveFrame, LiveNext, LiveStream, intrinsics_o
 use crate::render::{GroundPlane, ViewCamera};
 use crate::scene_tracking::{SceneFrame, SceneTracker};
 use crate::session::{Session, frame_dt};
-use crate::state::{DesignState, InputEvent, Parameters};
+use crate::state::{DesignState, InputEvent, Parameters, TouchPhase};
 use crate::ui::UiState;
 
 /// Seed of trees planted by the app.
@@ -49,6 +49,8 @@ pub struct Player {
     frame_clock_s: f64,
     /// Time of the last streamed frame shown.
     last_frame_time_s: f64,
+    /// Plant at the world origin once the ground is found (`sylva view --plant-at-origin`).
+    pub plant_at_origin: bool,
 }
 
 impl Player {
@@ -62,7 +64,8 @@ impl Player {
         let tracker = SceneTracker::open(&footage.root, footage.intrinsics)?;
         Ok(Player {
             session: Session::new(footage_ref, DEFAULT_SEED, params.clone()),
-            design: DesignState::new(DEFAULT_SEED, params),
+            design: DesignState::unplanted(DEFAULT_SEED, params)
+                .with_scene_worker(&footage.intrinsics),
             footage,
             ui,
             frame: 0,
@@ -71,6 +74,7 @@ impl Player {
             last_tick_s: None,
             frame_clock_s: 0.0,
             last_frame_time_s: 0.0,
+            plant_at_origin: false,
         })
     }
 
@@ -97,7 +101,8 @@ impl Player {
         let params = Parameters::default();
         Ok(Player {
             session: Session::new(root, DEFAULT_SEED, params.clone()),
-            design: DesignState::new(DEFAULT_SEED, params),
+            design: DesignState::unplanted(DEFAULT_SEED, params)
+                .with_scene_worker(&intrinsics_of(&camera)),
             footage,
             ui: UiState {
                 live: true,
@@ -114,6 +119,7 @@ impl Player {
             last_tick_s: None,
             frame_clock_s: 0.0,
             last_frame_time_s: 0.0,
+            plant_at_origin: false,
         })
     }
 
@@ -191,6 +197,12 @@ impl Player {
         self.ui.budget.tracking_ms = scene.tracking_ms;
         self.ui.ground_found = scene.ground.is_some();
         self.session.push_frame(&self.footage, index, scene);
+        self.design.observe_scene(
+            &self.footage.intrinsics,
+            scene.world_from_camera,
+            scene.ground,
+            &scene.observations,
+        );
         let time_s = self.footage.frames[index].time_s;
         self.advance_design(time_s, previous_time);
         Ok(())
@@ -201,6 +213,44 @@ impl Player {
         self.design
             .advance_frame(self.camera(), time_s, frame_dt(time_s - previous_time_s));
         self.ui.budget.growth_ms = started.elapsed().as_secs_f32() * 1000.0;
+        if self.plant_at_origin
+            && !self.design.is_planted()
+            && self.design.ground.is_some()
+            && let Some(p) = self
+                .design
+                .world_camera()
+                .and_then(|c| c.pixel_from_world(Vec3::ZERO))
+        {
+            // A tap at the origin's pixel, as the user would make it (and recorded so).
+            for phase in [TouchPhase::Start, TouchPhase::End] {
+                self.input(InputEvent::Touch {
+                    phase,
+                    id: 0,
+                    x: p.x,
+                    y: p.y,
+                });
+            }
+        }
+        self.ui.planted = self.design.is_planted();
+    }
+
+    /// The tracked camera of the current frame in tree space (how the frame is drawn: the
+    /// tree's mesh is in tree space).
+    pub fn camera_in_tree(&self) -> Option<ViewCamera> {
+        let camera = self.camera()?;
+        Some(crate::planting::camera_in_tree(
+            &camera,
+            &self.design.tree_from_world(),
+        ))
+    }
+
+    /// The ground plane in tree space.
+    pub fn ground_in_tree(&self) -> Option<GroundPlane> {
+        let ground = self.ground()?;
+        Some(crate::planting::ground_in_tree(
+            &ground,
+            &self.design.tree_from_world(),
+        ))
     }
 
     /// A stream: waits for its next frame and shows it. False once the stream has ended (and
@@ -258,6 +308,12 @@ impl Player {
         self.ui.num_frames = index + 1;
         self.ui.budget.tracking_ms = frame.scene.tracking_ms;
         self.ui.ground_found = frame.scene.ground.is_some();
+        self.design.observe_scene(
+            &self.footage.intrinsics,
+            frame.scene.world_from_camera,
+            frame.scene.ground,
+            &frame.scene.observations,
+        );
         self.image = Some(frame.rgba);
         live.shown = Some(frame.scene);
         self.last_frame_time_s = frame.time_s;
@@ -321,8 +377,25 @@ impl Player {
     }
 }
 
-/// Writes the tree as `tree.json` (the growth state) and `tree.glb` (its meshes) into `dir`;
-/// returns the path of the `.glb`.
+/// Where a design's tree stands, written next to its tree file.
+#[derive(Clone, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
+pub struct Placement {
+    /// Column-major `world_from_tree` (tree space: metres, Y up, trunk base at the origin);
+    /// None if the tree was never planted.
+    pub world_from_tree: Option<[f32; 12]>,
+}
+
+/// Writes where the design's tree stands ([`Placement`]) to `path`.
+pub fn write_placement(design: &DesignState, path: &Path) -> anyhow::Result<()> {
+    let json = serde_json::to_string_pretty(&Placement {
+        world_from_tree: design.world_from_tree.map(|m| m.to_cols_array()),
+    })?;
+    std::fs::write(path, json).with_context(|| format!("cannot write {}", path.display()))
+}
+
+/// Writes the tree as `tree.json` (the growth state, in tree space), `tree.glb` (its meshes)
+/// and `placement.json` (where it stands in the world) into `dir`; returns the path of the
+/// `.glb`.
 pub fn export_tree(design: &DesignState, dir: &Path) -> anyhow::Result<PathBuf> {
     std::fs::create_dir_all(dir).with_context(|| format!("cannot create {}", dir.display()))?;
     let json = dir.join("tree.json");
@@ -330,6 +403,7 @@ pub fn export_tree(design: &DesignState, dir: &Path) -> anyhow::Result<PathBuf> 
         .tree
         .save(&json)
         .with_context(|| format!("cannot write {}", json.display()))?;
+    write_placement(design, &dir.join("placement.json"))?;
     let glb = dir.join("tree.glb");
     let meshes = sylva_core::geometry::build_tree_meshes(&design.tree);
     sylva_core::export::write_glb(&meshes, &glb)

@@ -10,6 +10,7 @@ use glam::Mat4;
 use serde::{Deserialize, Serialize};
 
 use crate::footage::Footage;
+use crate::planting::{camera_in_tree, ground_in_tree, occluder_in_tree};
 use crate::render::offscreen::OFFSCREEN_FORMAT;
 use crate::render::{FrameView, Gpu, GroundPlane, Offscreen, Renderer, ViewCamera};
 use crate::scene_tracking::{SceneFrame, SceneMesher};
@@ -20,7 +21,11 @@ pub const SESSION_FORMAT: &str = "sylva-session";
 /// The largest side of replayed frames, pixels.
 const MAX_FRAME_SIDE: u32 = 8192;
 /// 2: frames record their tracked points (v1 sessions, made with ground-truth poses, are refused).
-pub const SESSION_VERSION: u32 = 2;
+/// 3: the tree is planted where the user taps the ground (a version 2 session replays as it was
+/// made: the tree planted at the world origin from the start), parameters carry the scene mode.
+pub const SESSION_VERSION: u32 = 3;
+/// The oldest version this build replays.
+pub const OLDEST_SESSION_VERSION: u32 = 2;
 
 /// Tracking output for one frame.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -40,6 +45,14 @@ pub struct FrameRecord {
 pub struct PointRecord(pub u64, pub f32, pub f32, pub f32);
 
 impl FrameRecord {
+    /// The recorded ground plane.
+    pub fn ground_plane(&self) -> Option<GroundPlane> {
+        self.ground.map(|g| GroundPlane {
+            point: glam::Vec3::new(g[0], g[1], g[2]),
+            normal: glam::Vec3::new(g[3], g[4], g[5]),
+        })
+    }
+
     /// The recorded tracked points as depth-mesh observations.
     pub fn observations(&self) -> Vec<Observation> {
         self.points
@@ -129,9 +142,11 @@ impl Session {
             .with_context(|| format!("cannot read session {}", path.display()))?;
         let session: Session = serde_json::from_str(&text)
             .with_context(|| format!("{} is not a valid session file", path.display()))?;
-        if session.format != SESSION_FORMAT || session.version != SESSION_VERSION {
+        if session.format != SESSION_FORMAT
+            || !(OLDEST_SESSION_VERSION..=SESSION_VERSION).contains(&session.version)
+        {
             bail!(
-                "{}: format `{}` version {} (this build reads `{SESSION_FORMAT}` version {SESSION_VERSION})",
+                "{}: format `{}` version {} (this build reads `{SESSION_FORMAT}` versions {OLDEST_SESSION_VERSION} to {SESSION_VERSION})",
                 path.display(),
                 session.format,
                 session.version
@@ -196,6 +211,16 @@ impl Session {
         Ok(())
     }
 
+    /// The design state a replay starts from: version 2 sessions had the tree planted at the
+    /// world origin from the start; later ones wait for a tap on the ground.
+    pub fn initial_design(&self) -> DesignState {
+        if self.version <= 2 {
+            DesignState::new(self.seed, self.parameters.clone())
+        } else {
+            DesignState::unplanted(self.seed, self.parameters.clone())
+        }
+    }
+
     pub fn save(&self, path: &Path) -> anyhow::Result<()> {
         // Compact: a few hundred tracked points per frame make pretty-printing several times
         // larger.
@@ -214,6 +239,8 @@ impl Session {
 #[derive(Clone, Debug, PartialEq)]
 pub struct ReplayReport {
     pub tree_sha256: String,
+    /// Where the tree stands (column-major `world_from_tree`), None if never planted.
+    pub world_from_tree: Option<[f32; 12]>,
     /// SHA-256 of each frame's RGBA pixels (empty when frames are not rendered).
     pub frame_sha256: Vec<String>,
     pub num_frames: usize,
@@ -222,8 +249,12 @@ pub struct ReplayReport {
 
 impl ReplayReport {
     pub fn summary_line(&self) -> String {
+        let base = match self.world_from_tree {
+            Some(m) => format!("{:.3},{:.3},{:.3}", m[9], m[10], m[11]),
+            None => "unplanted".into(),
+        };
         format!(
-            "tree_sha256={} frames={} ms_per_frame={:.1}",
+            "tree_sha256={} tree_base={base} frames={} ms_per_frame={:.1}",
             self.tree_sha256, self.num_frames, self.ms_per_frame
         )
     }
@@ -264,7 +295,7 @@ pub fn replay(
     // tracker and gives the same frames on every machine.
     let mut mesher = SceneMesher::new(&footage.intrinsics);
     let mut tree_mesher = crate::tree_model::TreeMesher::default();
-    let mut state = DesignState::new(session.seed, session.parameters.clone());
+    let mut state = session.initial_design();
     let mut meshed_revision = None;
     let mut frame_sha256 = Vec::new();
     let mut events = session.events.iter().peekable();
@@ -278,6 +309,12 @@ pub fn replay(
         }
         let dt = frame_dt(record.time_s - previous_time);
         previous_time = record.time_s;
+        state.observe_scene(
+            &footage.intrinsics,
+            camera.map(|c| c.world_from_camera),
+            record.ground_plane(),
+            &record.observations(),
+        );
         state.advance_frame(camera, record.time_s, dt);
         on_frame(step, &state);
         let Some((gpu, renderer, target)) = gpu_parts.as_mut() else {
@@ -296,17 +333,28 @@ pub fn replay(
             continue;
         };
         if meshed_revision != Some(state.revision) {
-            renderer.set_tree(gpu, tree_mesher.mesh(&state.tree));
+            // Nothing is shown before the tree is planted.
+            match state.is_planted() {
+                true => renderer.set_tree(gpu, tree_mesher.mesh(&state.tree)),
+                false => renderer.set_tree(gpu, &Default::default()),
+            }
             meshed_revision = Some(state.revision);
         }
         let rgba = footage.load_rgba(index)?;
         renderer.set_camera_image(gpu, rgba.as_raw(), footage.intrinsics);
-        let occluder = mesher.update(&record.observations(), camera.world_from_camera);
-        renderer.set_occluder(gpu, &occluder);
-        let ground = record.ground.map(|g| GroundPlane {
-            point: glam::Vec3::new(g[0], g[1], g[2]),
-            normal: glam::Vec3::new(g[3], g[4], g[5]),
-        });
+        // The frame is drawn in tree space (the tree's mesh is): camera, occluder and ground
+        // moved by tree_from_world.
+        let tree_from_world = state.tree_from_world();
+        let occluder = mesher.update(
+            &record.observations(),
+            camera.world_from_camera,
+            record.ground_plane(),
+        );
+        renderer.set_occluder(gpu, &occluder_in_tree(&occluder, &tree_from_world));
+        let ground = record
+            .ground_plane()
+            .map(|g| ground_in_tree(&g, &tree_from_world));
+        let camera = camera_in_tree(&camera, &tree_from_world);
         let image = target.render(gpu, renderer, &FrameView::augmented(camera, ground))?;
         write_frame(&image, step, out, &mut frame_sha256)?;
     }
@@ -317,6 +365,7 @@ pub fn replay(
     }
     Ok(ReplayReport {
         tree_sha256: state.tree_sha256(),
+        world_from_tree: state.world_from_tree.map(|m| m.to_cols_array()),
         frame_sha256,
         num_frames,
         ms_per_frame,

@@ -12,17 +12,20 @@
 
 use std::collections::BTreeMap;
 
-use glam::{Quat, Vec2, Vec3};
+use glam::{Affine3A, Quat, Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 use sylva_core::edit::{
     Bend, BendSettings, BrushSettings, BrushStroke, History, OperationKind, PositionalConstraint,
     StrokeCamera, Timeline, prune_at,
 };
 use sylva_core::environment::DepthConstraint;
+use sylva_core::environment::{Scene, SceneMode};
 use sylva_core::species::Species;
 use sylva_core::{NodeId, Tree};
 
-use crate::render::ViewCamera;
+use crate::planting::{SceneChoice, growth_scene, tree_scene};
+use crate::render::{GroundPlane, ViewCamera};
+use crate::scene_tracking::SceneOccupancy;
 
 /// Growth and brush parameters the UI exposes.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -53,6 +56,9 @@ pub struct Parameters {
     /// (flat, espalier-like crowns); none: free.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub depth_constraint_m: Option<f32>,
+    /// How the tracked scene shapes growth (absent in older sessions: free).
+    #[serde(default)]
+    pub scene_mode: SceneChoice,
 }
 
 impl Default for Parameters {
@@ -97,6 +103,7 @@ impl Parameters {
             brush_radius: 0.12,
             grow_speed: 10.0,
             depth_constraint_m: None,
+            scene_mode: SceneChoice::Free,
         }
     }
 
@@ -231,7 +238,7 @@ struct Touch {
 const TAP_SLOP_PX: f32 = 8.0;
 const DOUBLE_TAP_S: f64 = 0.35;
 const HOLD_S: f64 = 0.5;
-const PICK_RADIUS_PX: f32 = 25.0;
+pub(crate) const PICK_RADIUS_PX: f32 = 25.0;
 
 /// A three-finger bend in progress: the branch from `base` to its tip `end`, rotated about the
 /// start of `base` by `angle` radians about the view direction.
@@ -258,25 +265,38 @@ pub struct DesignState {
     last_tap: Option<(f64, Vec2)>,
     pub selected: Option<NodeId>,
     bend: Option<BendGesture>,
+    /// The camera in tree space (None while tracking is lost or before planting): picking,
+    /// the brush and gestures work in tree space.
     pub camera: Option<ViewCamera>,
+    /// The camera in the world.
+    pub(crate) world_camera: Option<ViewCamera>,
+    /// The ground plane in the world, once found.
+    pub ground: Option<GroundPlane>,
+    /// Where the tree stands in the world; None until a tap on the ground plants it.
+    pub world_from_tree: Option<Affine3A>,
+    /// The touch dragging the trunk base (moving the tree).
+    pub(crate) moving_base: Option<u64>,
+    /// The occupancy of the tracked scene (from the first frame with tracked points).
+    pub(crate) occupancy: Option<SceneOccupancy>,
     pub time_s: f64,
     /// Bumped whenever the tree changes (the renderer re-meshes on change).
     pub revision: u64,
     grow_debt: f32,
 }
 
-/// Grows `tree` autonomously to iteration `target` (keeping each iteration in `timeline`), or
-/// ungrows it to the kept iteration `target`.
+/// Grows `tree` autonomously to iteration `target` (keeping each iteration in `timeline`) against
+/// the scene when one is given, or ungrows it to the kept iteration `target`.
 fn move_to_iteration(
     tree: &mut Tree,
     timeline: &mut Timeline,
     target: u32,
+    scene: Option<(&dyn Scene, SceneMode)>,
 ) -> Result<(), sylva_core::edit::EditError> {
     if target < tree.iteration {
         return timeline.go_to(tree, target);
     }
     while tree.iteration < target {
-        tree.grow(1, None);
+        tree.grow(1, scene);
         timeline.keep(tree);
     }
     Ok(())
@@ -296,9 +316,19 @@ fn planted(species: Species, seed: u64) -> Tree {
 const MAX_UNDO: usize = 64;
 
 impl DesignState {
-    /// A sapling of `params.species` (the default species for an unknown name) at the ground
-    /// origin: its seedling grown [`PLANTED_ITERATIONS`] autonomous iterations.
+    /// A sapling of `params.species` (the default species for an unknown name) planted at the
+    /// world origin: its seedling grown [`PLANTED_ITERATIONS`] autonomous iterations (version 2
+    /// sessions, and tests that need no planting).
     pub fn new(seed: u64, params: Parameters) -> DesignState {
+        DesignState {
+            world_from_tree: Some(Affine3A::IDENTITY),
+            ..DesignState::unplanted(seed, params)
+        }
+    }
+
+    /// The same sapling waiting to be planted: nothing is shown or edited until a tap on the
+    /// ground plane plants it (the app and version 3 sessions).
+    pub fn unplanted(seed: u64, params: Parameters) -> DesignState {
         let mut species = species_named(&params.species);
         params.apply_to(&mut species);
         let tree = planted(species, seed);
@@ -318,6 +348,11 @@ impl DesignState {
             selected: None,
             bend: None,
             camera: None,
+            world_camera: None,
+            ground: None,
+            world_from_tree: None,
+            moving_base: None,
+            occupancy: None,
             time_s: 0.0,
             revision: 0,
             grow_debt: 0.0,
@@ -329,7 +364,7 @@ impl DesignState {
         self.history.num_undoable()
     }
 
-    fn changed(&mut self) {
+    pub(crate) fn changed(&mut self) {
         self.revision += 1;
     }
 
@@ -344,7 +379,8 @@ impl DesignState {
     /// device, held touches become selections, and while a stroke is painted the tree grows
     /// towards it (brush-guided iterations, `grow_speed` per second).
     pub fn advance_frame(&mut self, camera: Option<ViewCamera>, time_s: f64, dt_s: f32) {
-        self.camera = camera;
+        self.world_camera = camera;
+        self.update_tree_camera();
         self.time_s = time_s;
         if self.stroke.is_some() {
             self.add_stroke_point();
@@ -365,7 +401,20 @@ impl DesignState {
             return;
         };
         brush.emit_dab(&mut self.tree);
-        let stats = brush.iterate(&mut self.tree);
+        let stats = match growth_scene(
+            self.params.scene_mode,
+            &self.occupancy,
+            self.world_from_tree,
+        ) {
+            Some((scene, mode)) => {
+                brush.emit(&mut self.tree);
+                self.tree.step(sylva_core::growth::StepOptions {
+                    autonomous: false,
+                    scene: Some((&scene, mode)),
+                })
+            }
+            None => brush.iterate(&mut self.tree),
+        };
         self.timeline.keep(&self.tree);
         if stats.num_new_internodes > 0 {
             self.changed();
@@ -402,6 +451,7 @@ impl DesignState {
             self.params = Parameters {
                 brush_radius: brush.0,
                 grow_speed: brush.1,
+                scene_mode: parameters.scene_mode,
                 ..Parameters::for_species(&species)
             };
             self.tree = planted(species, self.seed);
@@ -413,11 +463,25 @@ impl DesignState {
         }
         let years_changed = parameters.years != self.params.years;
         let depth_changed = parameters.depth_constraint_m != self.params.depth_constraint_m;
+        let prune_now = parameters.scene_mode == SceneChoice::PruneToScene
+            && self.params.scene_mode != SceneChoice::PruneToScene;
         self.params = parameters.clone();
         if depth_changed {
             self.set_depth_constraint(parameters.depth_constraint_m);
         }
         parameters.apply_to(&mut self.tree.species);
+        if prune_now {
+            // Choosing "prune to the scene" cuts what free growth pushed into it.
+            if let Some(scene) = tree_scene(&self.occupancy, self.world_from_tree)
+                && self.tree.prune_to_scene(&scene) > 0
+            {
+                self.timeline.keep(&self.tree);
+                self.brush = None;
+                self.bend = None;
+                self.selected = None;
+                self.changed();
+            }
+        }
         if years_changed {
             self.grow_to_age(parameters.years);
         }
@@ -432,8 +496,14 @@ impl DesignState {
         let target = self.tree.species.iterations_for_years(years.max(0.0));
         let earliest = self.timeline.range().map_or(target, |(first, _)| first);
         let target = target.max(earliest);
+        let scene = growth_scene(
+            self.params.scene_mode,
+            &self.occupancy,
+            self.world_from_tree,
+        );
+        let scene = scene.as_ref().map(|(s, m)| (s as &dyn Scene, *m));
         if target == self.tree.iteration
-            || move_to_iteration(&mut self.tree, &mut self.timeline, target).is_err()
+            || move_to_iteration(&mut self.tree, &mut self.timeline, target, scene).is_err()
         {
             return;
         }
@@ -456,10 +526,16 @@ impl DesignState {
                 .saturating_sub(iterations.unsigned_abs())
         };
         let timeline = &mut self.timeline;
+        let scene = growth_scene(
+            self.params.scene_mode,
+            &self.occupancy,
+            self.world_from_tree,
+        );
+        let scene = scene.as_ref().map(|(s, m)| (s as &dyn Scene, *m));
         let result = self
             .history
             .perform(OperationKind::Grow, &mut self.tree, |tree| {
-                move_to_iteration(tree, timeline, target)
+                move_to_iteration(tree, timeline, target, scene)
             });
         if result.is_ok() {
             self.changed();
@@ -479,6 +555,7 @@ impl DesignState {
                     },
                 );
                 match self.touches.len() {
+                    1 if !self.is_planted() || self.begin_move(id, pixel) => {}
                     1 => self.begin_stroke(pixel),
                     3 => self.begin_bend(),
                     _ => self.end_stroke(false),
@@ -489,7 +566,11 @@ impl DesignState {
                     t.now = pixel;
                     t.moved |= t.now.distance(t.start) > TAP_SLOP_PX;
                 }
-                if self.bend.is_some() {
+                if self.moving_base == Some(id) {
+                    if self.touches.get(&id).is_some_and(|t| t.moved) {
+                        self.plant_at(pixel);
+                    }
+                } else if self.bend.is_some() {
                     self.update_bend();
                 } else if let Some(stroke) = self.stroke.as_mut() {
                     stroke.pixel = pixel;
@@ -506,6 +587,16 @@ impl DesignState {
                 }
                 let is_tap =
                     touch.is_some_and(|t| !t.moved && self.time_s - t.start_time_s < HOLD_S);
+                if self.moving_base.take_if(|m| *m == id).is_some() && !is_tap {
+                    return;
+                }
+                if !self.is_planted() {
+                    // Before planting, a tap on the ground plants the tree there.
+                    if is_tap && self.touches.is_empty() {
+                        self.plant_at(pixel);
+                    }
+                    return;
+                }
                 self.end_stroke(!is_tap);
                 if is_tap {
                     self.tap(pixel);

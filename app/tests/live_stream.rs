@@ -6,7 +6,7 @@
 
 use std::path::{Path, PathBuf};
 
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 use opencv::core::Size;
 use opencv::prelude::*;
 use opencv::{imgcodecs, videoio};
@@ -59,7 +59,7 @@ fn top_pixel(player: &Player) -> Option<Vec2> {
         .iter()
         .map(|i| i.end)
         .max_by(|a, b| a.y.total_cmp(&b.y))?;
-    player.camera()?.pixel_from_world(top)
+    player.camera_in_tree()?.pixel_from_world(top)
 }
 
 fn view_args(video: &Path) -> ViewArgs {
@@ -71,6 +71,7 @@ fn view_args(video: &Path) -> ViewArgs {
         frame: 0,
         paused: false,
         orbit: false,
+        plant_at_origin: false,
     }
 }
 
@@ -114,6 +115,13 @@ fn a_video_streamed_through_the_player_is_tracked_recorded_and_replays_to_the_sa
             y: p.y,
         };
         match since_ground {
+            // The user plants the tree by tapping the ground at the world origin.
+            Some(5) => {
+                if let Some(p) = player.camera().and_then(|c| c.pixel_from_world(Vec3::ZERO)) {
+                    player.input(touch(TouchPhase::Start, p));
+                    player.input(touch(TouchPhase::End, p));
+                }
+            }
             Some(10) => {
                 if let Some(p) = top_pixel(&player) {
                     finger = p;

@@ -2,7 +2,8 @@
 //! the ground: a screenshot at two frames of the walk finds tree pixels along the trunk's
 //! projection, and they move with the ground as the camera moves.
 //!
-//! The app plants the tree at the origin of the world its tracker builds. The test places that
+//! With `--plant-at-origin` the app taps the origin of the world its tracker builds once the
+//! ground is found (a user would tap a spot of their choosing). The test places that
 //! world in the scene's ground truth (the Sim(3) that aligns the tracked camera frames to the
 //! true ones) and projects the trunk through the *true* cameras: the tree must stand there, on
 //! one spot of the real ground, in both screenshots.
@@ -75,7 +76,12 @@ fn screenshot(
     let app = Command::new(env!("CARGO_BIN_EXE_sylva"))
         .arg("view")
         .arg(demo())
-        .args(["--frame", &frame.to_string(), "--paused"])
+        .args([
+            "--frame",
+            &frame.to_string(),
+            "--paused",
+            "--plant-at-origin",
+        ])
         .current_dir(dir)
         .env("DISPLAY", display)
         .env_remove("WAYLAND_DISPLAY")

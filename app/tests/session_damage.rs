@@ -56,7 +56,7 @@ fn damaged_sessions_are_refused_naming_the_file_and_the_value() {
                 events.push(json!({"frame": 3, "time_s": 1.0,
                     "event": {"kind": "grow", "iterations": 2_000_000_000}}));
             },
-            "event 178",
+            "grows 2000000000 iterations",
         ),
         (
             "pose.json",
@@ -79,4 +79,43 @@ fn damaged_sessions_are_refused_naming_the_file_and_the_value() {
             "{name}: {message}"
         );
     }
+}
+
+#[test]
+fn a_version_2_session_still_replays_with_the_tree_planted_at_the_origin_from_the_start() {
+    // Version 2 had no tap: the demo's events without its planting tap, as a v2 file.
+    let mut session = committed_session();
+    session["version"] = json!(2);
+    let events = session["events"].as_array_mut().expect("events");
+    assert_eq!(
+        events[0]["event"]["kind"], "touch",
+        "the demo starts with its tap"
+    );
+    events.drain(0..2);
+    let frames = session["frames"].as_array_mut().expect("frames");
+    frames.truncate(60);
+    let footage = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../test-data/demo_garden");
+    session["footage"] = json!(footage);
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("v2.json");
+    std::fs::write(&path, serde_json::to_string(&session).expect("encode")).expect("write");
+    let (mut first, mut sizes) = (None, Vec::new());
+    sylva_app::session::replay(&path, None, false, |step, state| {
+        if step == 0 {
+            first = Some(state.world_from_tree);
+        }
+        sizes.push(state.tree.skeleton.len());
+    })
+    .expect("a v2 session replays");
+    assert_eq!(
+        first,
+        Some(Some(glam::Affine3A::IDENTITY)),
+        "planted at the origin at once"
+    );
+    let grown = sizes.iter().max().copied().unwrap_or(0);
+    assert!(
+        grown > sizes[0],
+        "the first stroke grows it: {} -> {grown}",
+        sizes[0]
+    );
 }

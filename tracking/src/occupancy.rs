@@ -52,6 +52,7 @@ pub enum VoxelState {
 }
 
 /// A keyframe's surface, kept as a coarse depth raster for the "behind every view" test.
+#[derive(Clone)]
 struct KeyframeSurface {
     camera_from_world: Affine3A,
     camera: PinholeIntrinsics,
@@ -79,6 +80,7 @@ impl KeyframeSurface {
 }
 
 /// The sparse voxel map.
+#[derive(Clone)]
 pub struct OccupancyMap {
     config: OccupancyConfig,
     log_odds: HashMap<IVec3, f32>,

@@ -47,6 +47,8 @@ pub struct UiState {
     /// A live stream (camera, video): frames come as they come, there is nothing to seek.
     pub live: bool,
     pub ground_found: bool,
+    /// The tree is planted (until then a hint asks for a tap on the ground).
+    pub planted: bool,
     pub budget: FrameBudget,
     pub show_debug: bool,
     /// The tree alone, outside AR, in a view that orbits, pans and zooms.
@@ -65,6 +67,7 @@ impl Default for UiState {
             seek_to: None,
             live: false,
             ground_found: false,
+            planted: false,
             budget: FrameBudget::default(),
             show_debug: false,
             orbit_view: false,
@@ -189,7 +192,14 @@ fn playback_ui(ui: &mut Ui, state: &mut UiState) {
 
 fn overlays_ui(ui: &mut Ui, state: &UiState, view: egui::Rect) {
     let painter = ui.painter_at(view);
-    if !state.ground_found {
+    let hint = if !state.ground_found {
+        Some("Move the phone slowly to find the ground...")
+    } else if !state.planted {
+        Some("Tap the ground where the tree should stand")
+    } else {
+        None
+    };
+    if let Some(hint) = hint {
         painter.rect_filled(
             egui::Rect::from_center_size(view.center(), egui::vec2(360.0, 60.0)),
             8.0,
@@ -198,7 +208,7 @@ fn overlays_ui(ui: &mut Ui, state: &UiState, view: egui::Rect) {
         painter.text(
             view.center(),
             Align2::CENTER_CENTER,
-            "Move the phone slowly to find the ground...",
+            hint,
             egui::FontId::proportional(18.0),
             Color32::WHITE,
         );

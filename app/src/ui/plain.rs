@@ -148,6 +148,12 @@ pub fn tree_ui(ui: &mut Ui, params: &mut Parameters, species_names: &[String]) {
             set_straightness,
         );
     });
+    ui.horizontal_wrapped(|ui| {
+        ui.label("Scene:");
+        for choice in crate::planting::SceneChoice::ALL {
+            ui.selectable_value(&mut params.scene_mode, choice, choice.label());
+        }
+    });
     depth_tool_ui(ui, params);
 }
 
