@@ -246,9 +246,11 @@ impl DesktopApp {
                 let t = Instant::now();
                 // The seedling is planted once the ground is found.
                 match revision {
-                    Some(_) => gfx
-                        .renderer
-                        .set_tree(&gfx.gpu, self.tree_mesher.mesh(&self.player.design.tree)),
+                    Some(_) => gfx.renderer.set_tree(
+                        &gfx.gpu,
+                        self.tree_mesher
+                            .mesh_in(&self.player.design.tree, self.player.design.params.season),
+                    ),
                     None => gfx.renderer.set_tree(&gfx.gpu, &Default::default()),
                 }
                 self.player.ui.budget.meshing_ms = t.elapsed().as_secs_f32() * 1000.0;

@@ -296,7 +296,7 @@ pub fn replay(
             continue;
         };
         if meshed_revision != Some(state.revision) {
-            renderer.set_tree(gpu, tree_mesher.mesh(&state.tree));
+            renderer.set_tree(gpu, tree_mesher.mesh_in(&state.tree, state.params.season));
             meshed_revision = Some(state.revision);
         }
         let rgba = footage.load_rgba(index)?;

@@ -17,6 +17,7 @@ use sylva_core::edit::{
     Bend, BendSettings, BrushPlane, BrushSettings, BrushStroke, History, OperationKind,
     PositionalConstraint, Timeline, prune_at,
 };
+use sylva_core::geometry::Season;
 use sylva_core::species::Species;
 use sylva_core::{NodeId, Tree};
 
@@ -46,6 +47,14 @@ pub struct Parameters {
     pub brush_radius: f32,
     /// Growth iterations per second while brushing (negative: ungrow).
     pub grow_speed: f32,
+    /// The season the tree is shown in; sessions from before seasons are summer (and a summer
+    /// session records none, so it stays as it was).
+    #[serde(default, skip_serializing_if = "is_summer")]
+    pub season: Season,
+}
+
+fn is_summer(season: &Season) -> bool {
+    *season == Season::Summer
 }
 
 impl Default for Parameters {
@@ -89,6 +98,7 @@ impl Parameters {
             years: 5.0,
             brush_radius: 0.12,
             grow_speed: 10.0,
+            season: Season::Summer,
         }
     }
 
@@ -387,6 +397,7 @@ impl DesignState {
             self.params = Parameters {
                 brush_radius: brush.0,
                 grow_speed: brush.1,
+                season: parameters.season,
                 ..Parameters::for_species(&species)
             };
             self.tree = planted(species, self.seed);
@@ -397,6 +408,9 @@ impl DesignState {
             return;
         }
         let years_changed = parameters.years != self.params.years;
+        if parameters.season != self.params.season {
+            self.changed(); // the tree is drawn anew in its season
+        }
         self.params = parameters.clone();
         parameters.apply_to(&mut self.tree.species);
         if years_changed {

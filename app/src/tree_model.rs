@@ -3,7 +3,9 @@
 //! growth shadow grid), converted to the renderer's vertices.
 
 use glam::Vec3;
-use sylva_core::geometry::{Levels, Mesher, TreeMeshes, build_tree_level, mesh_params_for};
+use sylva_core::geometry::{
+    Levels, Mesher, Season, TreeMeshes, TreeShade, build_tree_level, mesh_params_in,
+};
 use sylva_core::{Skeleton, Tree};
 
 use crate::render::{LitMesh, LitVertex, TreeMesh};
@@ -75,11 +77,17 @@ pub struct TreeMesher {
 impl TreeMesher {
     /// The drawn mesh of `tree` (level 0 and leaves), as [`mesh_of`] builds it.
     pub fn mesh(&mut self, tree: &Tree) -> &TreeMesh {
-        let params = mesh_params_for(&tree.species);
+        self.mesh_in(tree, Season::Summer)
+    }
+
+    /// The drawn mesh of `tree` in `season` (a deciduous tree has no leaves in winter).
+    pub fn mesh_in(&mut self, tree: &Tree, season: Season) -> &TreeMesh {
+        let params = mesh_params_in(&tree.species, season);
+        let shade = TreeShade::new(tree);
         self.mesher.build_into(
             &tree.skeleton,
             &params,
-            &|p| tree.ambient_at(p),
+            &|p| shade.at(p),
             Levels::One(0),
             &mut self.meshes,
         );

@@ -10,6 +10,7 @@ pub mod touch;
 pub mod widgets;
 
 use egui::{Align2, Color32, RichText, Ui};
+use sylva_core::geometry::Season;
 
 use crate::state::{DesignState, InputEvent};
 
@@ -120,6 +121,7 @@ pub fn sylva_ui(
                     egui::Slider::new(&mut params.years, 1.0..=40.0)
                         .text("Age (years): grows or ungrows the tree"),
                 );
+                season_ui(ui, &mut params.season);
             }
             Tab::Export => {
                 if ui.button("Export tree (.glb, .json)").clicked() {
@@ -186,6 +188,17 @@ fn growth_ui(ui: &mut Ui, params: &mut crate::state::Parameters) {
         ui.add(
             egui::Slider::new(&mut params.max_shoot_length, 1.0..=20.0).text("n_max shoot length"),
         );
+    });
+}
+
+/// The season beside the years slider: one button per season (winter shows deciduous trees
+/// leafless).
+fn season_ui(ui: &mut Ui, season: &mut Season) {
+    ui.horizontal(|ui| {
+        ui.label("Season:");
+        for s in Season::ALL {
+            ui.selectable_value(season, s, s.name());
+        }
     });
 }
 
