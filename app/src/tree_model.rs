@@ -83,7 +83,7 @@ impl TreeMesher {
     /// The drawn mesh of `tree` in `season` (a deciduous tree has no leaves in winter).
     pub fn mesh_in(&mut self, tree: &Tree, season: Season) -> &TreeMesh {
         let params = mesh_params_in(&tree.species, season);
-        let shade = TreeShade::new(tree);
+        let shade = TreeShade::in_season(tree, season);
         self.mesher.build_into(
             &tree.skeleton,
             &params,

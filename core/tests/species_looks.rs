@@ -171,10 +171,23 @@ fn deciduous_presets_are_leafless_in_winter_and_their_leaves_change_colour_with_
         let name = &tree.species.name;
         assert!(!summer.leaves.is_empty(), "{name}");
         assert_eq!(winter.leaves.is_empty(), !evergreen, "{name} in winter");
-        assert_eq!(
-            winter.lods[0].branches, summer.lods[0].branches,
-            "{name}: same wood"
+        let (w, s) = (&winter.lods[0].branches, &summer.lods[0].branches);
+        assert!(
+            w.positions == s.positions && w.indices == s.indices,
+            "{name}: the same wood in winter"
         );
+        // A leafless crown lets more light onto its wood; an evergreen's is as dark.
+        let lighter = w.ambient.iter().zip(&s.ambient).all(|(w, s)| w >= s);
+        let mean = |a: &[f32]| a.iter().sum::<f32>() / a.len() as f32;
+        assert!(lighter, "{name}: winter wood darker than summer wood");
+        if evergreen {
+            assert!(w.ambient == s.ambient, "{name}: an evergreen's shade stays");
+        } else {
+            assert!(
+                mean(&w.ambient) > mean(&s.ambient) + 0.05,
+                "{name}: a bare crown as dark as in leaf"
+            );
+        }
         if !evergreen {
             assert_ne!(
                 autumn.colors.leaf, summer.colors.leaf,

@@ -315,18 +315,31 @@ pub fn mesh_params_in(species: &Species, season: Season) -> MeshParams {
     }
 }
 
+/// Share of the shadow grid's shade a leafless crown keeps: bare deciduous crowns pass roughly
+/// 50–80% of the light, crowns in leaf 2–10%, so about a third of the shade is the wood's.
+pub const LEAFLESS_SHADE_KEPT: f32 = 0.35;
+
 /// The shade a mesh vertex at a world point gets: the ambient light of the tree's shadow grid
-/// ([`Tree::ambient_at`]), darkened on the trunk's dark base when the species has one (the
-/// points of the trunk's own axis below the base's top, where its rings sample the shade).
+/// ([`Tree::ambient_at`]), lighter in a leafless crown ([`LEAFLESS_SHADE_KEPT`]), darkened on
+/// the trunk's dark base when the species has one (the points of the trunk's own axis below
+/// the base's top, where its rings sample the shade).
 pub struct TreeShade<'a> {
     tree: &'a Tree,
+    /// Share of the grid's shade kept: 1 in leaf.
+    shade_kept: f32,
     /// Trunk axis points within the dark base and their shade, lowest first.
     dark_base: Vec<(Vec3, f32)>,
     top_y: f32,
 }
 
 impl<'a> TreeShade<'a> {
+    /// The shade of `tree` in leaf.
     pub fn new(tree: &'a Tree) -> Self {
+        Self::in_season(tree, Season::Summer)
+    }
+
+    /// The shade of `tree` in `season` (lighter when the tree is leafless then).
+    pub fn in_season(tree: &'a Tree, season: Season) -> Self {
         let bark = &tree.species.looks().bark;
         let skeleton = &tree.skeleton;
         let mut dark_base = Vec::new();
@@ -349,8 +362,10 @@ impl<'a> TreeShade<'a> {
                 }
             }
         }
+        let leafless = tree.species.looks().leaf_color_in(season).is_none();
         TreeShade {
             tree,
+            shade_kept: if leafless { LEAFLESS_SHADE_KEPT } else { 1.0 },
             dark_base,
             top_y,
         }
@@ -358,7 +373,7 @@ impl<'a> TreeShade<'a> {
 
     /// The shade at `point_in_world`, 0..1.
     pub fn at(&self, point_in_world: Vec3) -> f32 {
-        let ambient = self.tree.ambient_at(point_in_world);
+        let ambient = 1.0 - (1.0 - self.tree.ambient_at(point_in_world)) * self.shade_kept;
         if point_in_world.y > self.top_y {
             return ambient;
         }
@@ -374,9 +389,11 @@ pub fn build_tree_meshes(tree: &Tree) -> super::TreeMeshes {
     build_tree_meshes_in(tree, Season::Summer)
 }
 
-/// Meshes of a grown tree with its species' look in `season`.
+/// Meshes of a grown tree with its species' look in `season`, shaded by [`TreeShade`].
 pub fn build_tree_meshes_in(tree: &Tree, season: Season) -> super::TreeMeshes {
-    build_tree_meshes_with(tree, &mesh_params_in(&tree.species, season))
+    let shade = TreeShade::in_season(tree, season);
+    let params = mesh_params_in(&tree.species, season);
+    super::build_meshes(&tree.skeleton, &params, &|p| shade.at(p))
 }
 
 /// Meshes of a grown tree with its species' summer look at level of detail `level` only (see
@@ -387,7 +404,7 @@ pub fn build_tree_level(tree: &Tree, level: usize) -> super::TreeMeshes {
     super::build_level(&tree.skeleton, &params, &|p| shade.at(p), level)
 }
 
-/// Meshes of a grown tree with explicit parameters, shaded by [`TreeShade`].
+/// Meshes of a grown tree with explicit parameters, shaded by [`TreeShade`] (in leaf).
 pub fn build_tree_meshes_with(tree: &Tree, params: &MeshParams) -> super::TreeMeshes {
     let shade = TreeShade::new(tree);
     super::build_meshes(&tree.skeleton, params, &|p| shade.at(p))
