@@ -2,6 +2,8 @@
 //! part of it and the meshes and exported textures follow, damaged values are refused naming
 //! the file and the field, and files from before looks were data still load as they looked.
 
+mod support;
+
 use serde_json::Value;
 use sylva_core::Tree;
 use sylva_core::geometry::{BarkKind, LeafShape, Looks, Season, build_tree_meshes_in};
@@ -194,5 +196,28 @@ fn deciduous_presets_are_leafless_in_winter_and_their_leaves_change_colour_with_
                 "{name} turns in autumn"
             );
         }
+    }
+}
+
+#[test]
+fn season_exports_pass_the_khronos_validator_with_their_species_textures() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    for (name, season) in [
+        ("birch", Season::Winter),
+        ("oak", Season::Autumn),
+        ("norway_spruce", Season::Winter),
+        ("maple", Season::Spring),
+    ] {
+        let mut tree = Tree::new(Species::by_name(name).expect("preset"), 8);
+        tree.grow_years(7.0);
+        let meshes = build_tree_meshes_in(&tree, season);
+        let path = dir.path().join(format!("{name}_{season}.glb"));
+        sylva_core::export::write_glb(&meshes, &path).expect("exports");
+        let report = support::validate_glb(&path);
+        assert!(
+            report.num_errors == 0 && report.num_warnings == 0,
+            "{name} in {season}: {}",
+            report.text
+        );
     }
 }
