@@ -96,6 +96,8 @@ impl TreeMesher {
             None => self.mesh.branches = LitMesh::default(),
         }
         lit_into(&self.meshes.leaves, leaf_uv, &mut self.mesh.leaves);
+        self.mesh.bark_color = self.meshes.colors.bark;
+        self.mesh.leaf_color = self.meshes.colors.leaf;
         &self.mesh
     }
 
@@ -120,7 +122,12 @@ pub fn draw_mesh(meshes: &TreeMeshes) -> TreeMesh {
         .map(|lod| lit(&lod.branches, |uv| uv))
         .unwrap_or_default();
     let leaves = lit(&meshes.leaves, leaf_uv);
-    TreeMesh { branches, leaves }
+    TreeMesh {
+        branches,
+        leaves,
+        bark_color: meshes.colors.bark,
+        leaf_color: meshes.colors.leaf,
+    }
 }
 
 fn lit(mesh: &sylva_core::geometry::TreeMesh, uv_of: impl Fn([f32; 2]) -> [f32; 2]) -> LitMesh {

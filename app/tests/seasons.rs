@@ -43,6 +43,22 @@ fn the_season_control_redraws_the_design_leafless_in_winter_without_touching_the
         summer.branches.vertices.len()
     );
 
+    // The drawn colours are the species' in its season: a red-orange autumn maple.
+    state.apply(&with(&state, 6.0, Season::Autumn));
+    let autumn = mesher.mesh_in(&state.tree, state.params.season).clone();
+    let [r, g, b] = autumn.leaf_color;
+    assert!(
+        r > 3.0 * g && r > 3.0 * b,
+        "autumn maple leaves {:?}",
+        autumn.leaf_color
+    );
+    assert!(
+        summer.leaf_color[1] > summer.leaf_color[0],
+        "summer maple leaves are green"
+    );
+    assert_eq!(autumn.bark_color, summer.bark_color);
+    state.apply(&with(&state, 6.0, Season::Winter));
+
     // Another species keeps the season.
     state.apply(&InputEvent::Parameters {
         parameters: Parameters {
