@@ -5,6 +5,7 @@ use std::time::Instant;
 
 use anyhow::Context;
 use sylva_core::Tree;
+use sylva_core::geometry::Season;
 use sylva_core::species::Species;
 
 use crate::state::MAX_DESIGN_YEARS;
@@ -30,6 +31,10 @@ pub struct GrowArgs {
     /// Also export the finest level of detail as Wavefront OBJ + MTL, textures next to it.
     #[arg(long)]
     pub obj: Option<PathBuf>,
+    /// The season the exported meshes show: spring, summer, autumn or winter (deciduous trees
+    /// leafless, conifers keep their needles).
+    #[arg(long, default_value_t = Season::Summer)]
+    pub season: Season,
 }
 
 /// Prints one line per preset, starting with its name.
@@ -79,7 +84,7 @@ pub fn grow(args: GrowArgs) -> anyhow::Result<()> {
     tree.grow_years(args.years);
     let elapsed_ms = started.elapsed().as_secs_f64() * 1000.0;
     tree.save(&args.out)?;
-    export_meshes(&tree, args.glb.as_deref(), args.obj.as_deref())?;
+    export_meshes(&tree, args.season, args.glb.as_deref(), args.obj.as_deref())?;
     let m = tree.metrics();
     println!(
         "internodes={} height_m={:.3} crown_width_m={:.3} trunk_diameter_m={:.4} elapsed_ms={:.1}",
@@ -88,21 +93,34 @@ pub fn grow(args: GrowArgs) -> anyhow::Result<()> {
     Ok(())
 }
 
-/// Writes the `--glb` and `--obj` files, if asked for, one line each (before the summary line,
-/// which stays the last line of the output).
-fn export_meshes(tree: &Tree, glb: Option<&Path>, obj: Option<&Path>) -> anyhow::Result<()> {
+/// Writes the `--glb` and `--obj` files of the tree in `season`, if asked for, one line each
+/// (before the summary line, which stays the last line of the output).
+fn export_meshes(
+    tree: &Tree,
+    season: Season,
+    glb: Option<&Path>,
+    obj: Option<&Path>,
+) -> anyhow::Result<()> {
     if glb.is_none() && obj.is_none() {
         return Ok(());
     }
-    let meshes = sylva_core::geometry::build_tree_meshes(tree);
+    let meshes = sylva_core::geometry::build_tree_meshes_in(tree, season);
     let triangles = [0, 1, 2].map(|lod| meshes.num_triangles(lod));
+    let leaves = meshes.leaves.indices.len() / 6;
     if let Some(path) = glb {
         sylva_core::export::write_glb(&meshes, path)?;
-        println!("glb={} lod_triangles={:?}", path.display(), triangles);
+        println!(
+            "glb={} season={season} leaves={leaves} lod_triangles={triangles:?}",
+            path.display()
+        );
     }
     if let Some(path) = obj {
         sylva_core::export::write_obj(&meshes, path)?;
-        println!("obj={} triangles={}", path.display(), triangles[0]);
+        println!(
+            "obj={} season={season} leaves={leaves} triangles={}",
+            path.display(),
+            triangles[0]
+        );
     }
     Ok(())
 }

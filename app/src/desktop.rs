@@ -246,9 +246,11 @@ impl DesktopApp {
             if self.meshed_revision != revision {
                 let t = Instant::now();
                 match revision {
-                    Some(_) => gfx
-                        .renderer
-                        .set_tree(&gfx.gpu, self.tree_mesher.mesh(&self.player.design.tree)),
+                    Some(_) => gfx.renderer.set_tree(
+                        &gfx.gpu,
+                        self.tree_mesher
+                            .mesh_in(&self.player.design.tree, self.player.design.params.season),
+                    ),
                     None => gfx.renderer.set_tree(&gfx.gpu, &Default::default()),
                 }
                 self.player.ui.budget.meshing_ms = t.elapsed().as_secs_f32() * 1000.0;

@@ -20,6 +20,7 @@ use sylva_core::edit::{
 };
 use sylva_core::environment::DepthConstraint;
 use sylva_core::environment::{Scene, SceneMode};
+use sylva_core::geometry::Season;
 use sylva_core::species::Species;
 use sylva_core::{NodeId, Tree};
 
@@ -59,6 +60,14 @@ pub struct Parameters {
     /// How the tracked scene shapes growth (absent in older sessions: free).
     #[serde(default)]
     pub scene_mode: SceneChoice,
+    /// The season the tree is shown in; sessions from before seasons are summer (and a summer
+    /// session records none, so it stays as it was).
+    #[serde(default, skip_serializing_if = "is_summer")]
+    pub season: Season,
+}
+
+fn is_summer(season: &Season) -> bool {
+    *season == Season::Summer
 }
 
 impl Default for Parameters {
@@ -104,6 +113,7 @@ impl Parameters {
             grow_speed: 10.0,
             depth_constraint_m: None,
             scene_mode: SceneChoice::Free,
+            season: Season::Summer,
         }
     }
 
@@ -452,6 +462,7 @@ impl DesignState {
                 brush_radius: brush.0,
                 grow_speed: brush.1,
                 scene_mode: parameters.scene_mode,
+                season: parameters.season,
                 ..Parameters::for_species(&species)
             };
             self.tree = planted(species, self.seed);
@@ -465,6 +476,9 @@ impl DesignState {
         let depth_changed = parameters.depth_constraint_m != self.params.depth_constraint_m;
         let prune_now = parameters.scene_mode == SceneChoice::PruneToScene
             && self.params.scene_mode != SceneChoice::PruneToScene;
+        if parameters.season != self.params.season {
+            self.changed(); // the tree is drawn anew in its season
+        }
         self.params = parameters.clone();
         if depth_changed {
             self.set_depth_constraint(parameters.depth_constraint_m);

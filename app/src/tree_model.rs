@@ -3,7 +3,9 @@
 //! growth shadow grid), converted to the renderer's vertices.
 
 use glam::Vec3;
-use sylva_core::geometry::{Levels, Mesher, TreeMeshes, build_tree_level, mesh_params_for};
+use sylva_core::geometry::{
+    Levels, Mesher, Season, TreeMeshes, TreeShade, build_tree_level, mesh_params_in,
+};
 use sylva_core::{Skeleton, Tree};
 
 use crate::render::{LitMesh, LitVertex, TreeMesh};
@@ -75,11 +77,17 @@ pub struct TreeMesher {
 impl TreeMesher {
     /// The drawn mesh of `tree` (level 0 and leaves), as [`mesh_of`] builds it.
     pub fn mesh(&mut self, tree: &Tree) -> &TreeMesh {
-        let params = mesh_params_for(&tree.species);
+        self.mesh_in(tree, Season::Summer)
+    }
+
+    /// The drawn mesh of `tree` in `season` (a deciduous tree has no leaves in winter).
+    pub fn mesh_in(&mut self, tree: &Tree, season: Season) -> &TreeMesh {
+        let params = mesh_params_in(&tree.species, season);
+        let shade = TreeShade::in_season(tree, season);
         self.mesher.build_into(
             &tree.skeleton,
             &params,
-            &|p| tree.ambient_at(p),
+            &|p| shade.at(p),
             Levels::One(0),
             &mut self.meshes,
         );
@@ -88,6 +96,8 @@ impl TreeMesher {
             None => self.mesh.branches = LitMesh::default(),
         }
         lit_into(&self.meshes.leaves, leaf_uv, &mut self.mesh.leaves);
+        self.mesh.bark_color = self.meshes.colors.bark;
+        self.mesh.leaf_color = self.meshes.colors.leaf;
         &self.mesh
     }
 
@@ -112,7 +122,12 @@ pub fn draw_mesh(meshes: &TreeMeshes) -> TreeMesh {
         .map(|lod| lit(&lod.branches, |uv| uv))
         .unwrap_or_default();
     let leaves = lit(&meshes.leaves, leaf_uv);
-    TreeMesh { branches, leaves }
+    TreeMesh {
+        branches,
+        leaves,
+        bark_color: meshes.colors.bark,
+        leaf_color: meshes.colors.leaf,
+    }
 }
 
 fn lit(mesh: &sylva_core::geometry::TreeMesh, uv_of: impl Fn([f32; 2]) -> [f32; 2]) -> LitMesh {

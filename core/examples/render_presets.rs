@@ -4,7 +4,9 @@
 //! disc of lawn at the ground plane (darker where the crown shades it).
 //! Stands in for the app's offscreen renderer for the README pictures.
 //!
-//! `cargo run --release -p sylva-core --example render_presets [years] [out_dir]`
+//! `cargo run --release -p sylva-core --example render_presets [years] [out_dir] [season]`
+//! (summer by default; the files of another season are named `<name>_<season>.png`), and with
+//! `textures` as the years, each species' bark and leaf texture into `out_dir`.
 
 use std::path::PathBuf;
 
@@ -14,7 +16,7 @@ use glam::{Mat4, Vec2, Vec3, Vec4Swizzles};
 use image::{Rgba, RgbaImage};
 use sylva_core::Tree;
 use sylva_core::geometry::textures::{bark_texture, leaf_texture};
-use sylva_core::geometry::{TreeMesh, build_tree_meshes};
+use sylva_core::geometry::{Season, TreeMesh, build_tree_meshes_in};
 use sylva_core::species::Species;
 
 const WIDTH: u32 = 480;
@@ -185,9 +187,10 @@ fn draw_ground(target: &mut Target, tree: &Tree, radius: f32, clip_from_world: M
 
 fn render(
     tree: &Tree,
+    season: Season,
     out: &std::path::Path,
 ) -> Result<(usize, usize), Box<dyn std::error::Error>> {
-    let meshes = build_tree_meshes(tree);
+    let meshes = build_tree_meshes_in(tree, season);
     let (lo, hi) = meshes.bounds(0).ok_or("the tree has no geometry")?;
     let center = (lo + hi) * 0.5;
     let size = (hi - lo).max_element().max(0.5);
@@ -209,8 +212,13 @@ fn render(
     let ground_radius = 0.6 * (hi - lo).x.max((hi - lo).z).max(1.0);
     draw_ground(&mut target, tree, ground_radius, clip_from_world);
     let lod = &meshes.lods[0];
-    let bark = bark_texture(meshes.colors.bark, 128);
-    let leaf = leaf_texture(meshes.colors.leaf, 128);
+    let bark = image::DynamicImage::from(bark_texture(
+        meshes.colors.bark_kind,
+        meshes.colors.bark,
+        128,
+    ))
+    .to_rgba8();
+    let leaf = leaf_texture(meshes.colors.leaf_shape, meshes.colors.leaf, 128);
     let fruit = RgbaImage::from_pixel(
         1,
         1,
@@ -256,19 +264,53 @@ fn render(
 
 fn main() -> Result<(), Box<dyn std::error::Error>> {
     let mut args = std::env::args().skip(1);
-    let years: f32 = args.next().and_then(|a| a.parse().ok()).unwrap_or(12.0);
+    let years_arg = args.next();
     let out_dir = PathBuf::from(args.next().unwrap_or_else(|| "docs/images".into()));
+    let season: Season = match args.next() {
+        Some(name) => name.parse()?,
+        None => Season::Summer,
+    };
     std::fs::create_dir_all(&out_dir)?;
+    if years_arg.as_deref() == Some("textures") {
+        return write_textures(&out_dir);
+    }
+    let years: f32 = years_arg.and_then(|a| a.parse().ok()).unwrap_or(12.0);
     for species in Species::presets() {
         let name = species.name.clone();
         let mut tree = Tree::new(species, SEED);
         tree.grow_years(years);
-        let path = out_dir.join(format!("{name}.png"));
-        let (internodes, triangles) = render(&tree, &path)?;
+        let file = match season {
+            Season::Summer => format!("{name}.png"),
+            other => format!("{name}_{other}.png"),
+        };
+        let path = out_dir.join(file);
+        let (internodes, triangles) = render(&tree, season, &path)?;
         println!(
             "{}: {internodes} internodes, {triangles} triangles at {years} years",
             path.display()
         );
+    }
+    Ok(())
+}
+
+/// Each species' bark and summer leaf texture, 256 pixels, as `<name>_bark.png` and
+/// `<name>_leaf.png` (the leaf over a white card, as it would be seen).
+fn write_textures(out_dir: &std::path::Path) -> Result<(), Box<dyn std::error::Error>> {
+    for species in Species::presets() {
+        let looks = species.looks();
+        let bark = bark_texture(looks.bark.kind, looks.bark.color, 256);
+        bark.save(out_dir.join(format!("{}_bark.png", species.name)))?;
+        let leaf = leaf_texture(looks.leaf_shape, looks.leaf_color.summer, 256);
+        let on_white = RgbaImage::from_fn(256, 256, |x, y| {
+            let p = leaf.get_pixel(x, y);
+            if p[3] == 0 {
+                Rgba([255, 255, 255, 255])
+            } else {
+                *p
+            }
+        });
+        on_white.save(out_dir.join(format!("{}_leaf.png", species.name)))?;
+        println!("{}: bark and leaf textures", species.name);
     }
     Ok(())
 }

@@ -466,6 +466,21 @@ impl Tree {
         Ok(())
     }
 
+    /// The diameter of the trunk at `height_m` above its base: of the internode of the main axis
+    /// (the root and its main children) that spans that height; `None` when the trunk does
+    /// not reach it.
+    pub fn trunk_diameter_at(&self, height_m: f32) -> Option<f32> {
+        let skeleton = &self.skeleton;
+        let mut node = skeleton.internodes.first()?;
+        let top = node.start.y + height_m;
+        loop {
+            if node.end.y >= top {
+                return Some(node.diameter);
+            }
+            node = skeleton.get(node.main_child?);
+        }
+    }
+
     /// Height, crown spread, trunk diameter, size and lean.
     pub fn metrics(&self) -> TreeMetrics {
         let nodes = &self.skeleton.internodes;

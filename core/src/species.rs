@@ -6,10 +6,12 @@
 //! Pałubicki et al. 2009.
 
 use std::path::Path;
+use std::sync::OnceLock;
 
 use serde::{Deserialize, Serialize};
 
 use crate::environment::MAX_SHADOW_DEPTH_VOXELS;
+use crate::geometry::Looks;
 use crate::growth::TreeMetrics;
 
 /// Arrangement of lateral buds along an axis.
@@ -46,6 +48,53 @@ pub struct ExpectedSize {
     pub spread_30y_m: f32,
     /// The reference(s) the figures come from, by name.
     pub source: String,
+    /// Trunk diameter at breast height of an open-grown tree, with its own source; `None` in
+    /// files that state none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub trunk_diameter: Option<ExpectedTrunk>,
+}
+
+/// Height above the ground at which trunk diameters are stated (breast height), metres.
+pub const BREAST_HEIGHT_M: f32 = 1.3;
+
+/// The range of trunk diameters at breast height ([`BREAST_HEIGHT_M`]) an open-grown tree of the
+/// species reaches at 15, 30 and 40 years: `[least, most]`, metres.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ExpectedTrunk {
+    pub at_15y_m: [f32; 2],
+    pub at_30y_m: [f32; 2],
+    pub at_40y_m: [f32; 2],
+    /// The reference(s) the ranges come from, by name.
+    pub source: String,
+}
+
+impl ExpectedTrunk {
+    /// (age in years, [least, most] diameter in metres) of each stated range.
+    pub fn ranges(&self) -> [(f32, [f32; 2]); 3] {
+        [
+            (15.0, self.at_15y_m),
+            (30.0, self.at_30y_m),
+            (40.0, self.at_40y_m),
+        ]
+    }
+
+    fn validate(&self) -> Result<(), String> {
+        for (age, [least, most]) in self.ranges() {
+            if !(least.is_finite()
+                && most.is_finite()
+                && 0.0 < least
+                && least <= most
+                && most <= 5.0)
+            {
+                return Err(format!(
+                    "expected.trunk_diameter.at_{age}y_m must be [least, most] metres with \
+                     0 < least <= most <= 5, got [{least}, {most}]"
+                ));
+            }
+        }
+        Ok(())
+    }
 }
 
 impl ExpectedSize {
@@ -164,6 +213,11 @@ pub struct Species {
     pub tip_diameter_m: f32,
     /// n: pipe-model exponent, d^n = Σ d_i^n (re-solved below width constraints).
     pub pipe_exponent: f32,
+    /// Leaves, bark and fruit; read it through [`Species::looks`]. `None` in files from before
+    /// looks were data: such a species looks like the preset of its name, as it always did, or
+    /// else like a generic broadleaf ([`Looks::default`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub looks: Option<Looks>,
 }
 
 /// A species file that cannot be used.
@@ -419,7 +473,34 @@ impl Species {
                 self.max_points_per_bud
             ));
         }
-        Ok(())
+        if let Some(trunk) = &self.expected.trunk_diameter {
+            trunk.validate()?;
+        }
+        match &self.looks {
+            Some(looks) => looks.validate(),
+            None => Ok(()),
+        }
+    }
+
+    /// How the species looks: its own `looks`, or for a file without them the look of the
+    /// preset of its name, or a generic broadleaf.
+    pub fn looks(&self) -> &Looks {
+        static PRESET_LOOKS: OnceLock<Vec<(String, Looks)>> = OnceLock::new();
+        static GENERIC: OnceLock<Looks> = OnceLock::new();
+        if let Some(looks) = &self.looks {
+            return looks;
+        }
+        let presets = PRESET_LOOKS.get_or_init(|| {
+            Species::presets()
+                .into_iter()
+                .filter_map(|s| s.looks.map(|looks| (s.name, looks)))
+                .collect()
+        });
+        presets
+            .iter()
+            .find(|(name, _)| *name == self.name)
+            .map(|(_, looks)| looks)
+            .unwrap_or_else(|| GENERIC.get_or_init(Looks::default))
     }
 
     /// Lateral buds per node implied by the phyllotaxis.

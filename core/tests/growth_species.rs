@@ -4,7 +4,7 @@
 
 mod support;
 
-use support::mean_rise;
+use support::{mean_rise, median};
 use sylva_core::Tree;
 use sylva_core::species::Species;
 
@@ -19,11 +19,6 @@ const OUTLIER_TOLERANCE: f32 = 0.50;
 /// The median tree's lean at 30 years (`TreeMetrics::lean`: horizontal offset of the wood's
 /// centre over the height) is at most this.
 const MAX_MEDIAN_LEAN: f32 = 0.12;
-
-fn median(mut values: Vec<f32>) -> f32 {
-    values.sort_by(f32::total_cmp);
-    values[values.len() / 2]
-}
 
 #[test]
 fn every_preset_lands_within_30_percent_of_its_stated_height_and_spread_at_10_and_30_years() {

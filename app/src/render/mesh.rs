@@ -43,11 +43,25 @@ impl LitMesh {
     }
 }
 
-/// The tree as drawn: bark and leaves.
-#[derive(Clone, Debug, Default, PartialEq)]
+/// The tree as drawn: bark and leaves, and their linear RGB (the species' look in its season).
+#[derive(Clone, Debug, PartialEq)]
 pub struct TreeMesh {
     pub branches: LitMesh,
     pub leaves: LitMesh,
+    pub bark_color: [f32; 3],
+    pub leaf_color: [f32; 3],
+}
+
+impl Default for TreeMesh {
+    /// No geometry, in the renderer's former fixed bark and leaf colours.
+    fn default() -> Self {
+        TreeMesh {
+            branches: LitMesh::default(),
+            leaves: LitMesh::default(),
+            bark_color: [0.30, 0.21, 0.14],
+            leaf_color: [0.16, 0.38, 0.09],
+        }
+    }
 }
 
 impl TreeMesh {

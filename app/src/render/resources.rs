@@ -31,6 +31,9 @@ struct Globals {
     image: [f32; 4],
     viewport: [f32; 4],
     misc: [f32; 4],
+    /// rgb: linear bark and leaf colours of the tree; w unused.
+    bark_color: [f32; 4],
+    leaf_color: [f32; 4],
 }
 
 struct GpuMesh {
@@ -59,6 +62,8 @@ pub struct Renderer {
     branches: Option<GpuMesh>,
     leaves: Option<GpuMesh>,
     tree_bounds: Option<(Vec3, Vec3)>,
+    /// Linear RGB of the tree's bark and leaves.
+    tree_colors: [[f32; 3]; 2],
     occluder: Option<GpuMesh>,
     wireframe: Option<GpuMesh>,
     points: Option<GpuMesh>,
@@ -158,6 +163,10 @@ impl Renderer {
             branches: None,
             leaves: None,
             tree_bounds: None,
+            tree_colors: {
+                let none = TreeMesh::default();
+                [none.bark_color, none.leaf_color]
+            },
             occluder: None,
             wireframe: None,
             points: None,
@@ -175,6 +184,7 @@ impl Renderer {
         self.branches = upload_lit(&gpu.device, &tree.branches);
         self.leaves = upload_lit(&gpu.device, &tree.leaves);
         self.tree_bounds = tree.bounds();
+        self.tree_colors = [tree.bark_color, tree.leaf_color];
     }
 
     /// Uploads the scene's depth mesh (occluder and wireframe).
@@ -405,6 +415,8 @@ impl Renderer {
             ],
             viewport: region,
             misc: [3.0, texel, 1.5, 0.0],
+            bark_color: Vec3::from(self.tree_colors[0]).extend(1.0).to_array(),
+            leaf_color: Vec3::from(self.tree_colors[1]).extend(1.0).to_array(),
         }
     }
 }

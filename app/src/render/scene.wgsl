@@ -26,6 +26,9 @@ struct Globals {
     viewport: vec4<f32>,
     // point size (px), shadow map texel size (uv), PCF spacing (texels), unused.
     misc: vec4<f32>,
+    // rgb: linear bark and leaf colours of the tree (its species in its season); w unused.
+    bark_color: vec4<f32>,
+    leaf_color: vec4<f32>,
 }
 
 @group(0) @binding(0) var<uniform> g: Globals;
@@ -34,8 +37,6 @@ struct Globals {
 @group(0) @binding(3) var background: texture_2d<f32>;
 @group(0) @binding(4) var linear_sampler: sampler;
 
-const BARK: vec3<f32> = vec3<f32>(0.30, 0.21, 0.14);
-const LEAF: vec3<f32> = vec3<f32>(0.16, 0.38, 0.09);
 const LAWN: vec3<f32> = vec3<f32>(0.22, 0.42, 0.16);
 const SKY: vec3<f32> = vec3<f32>(0.72, 0.82, 1.0);
 
@@ -97,7 +98,7 @@ fn vs_lit(v: LitIn) -> LitOut {
 @fragment
 fn fs_branch(v: LitOut) -> @location(0) vec4<f32> {
     let n = normalize(v.normal);
-    return vec4<f32>(shade(BARK, n, v.world, v.ambient), 1.0);
+    return vec4<f32>(shade(g.bark_color.rgb, n, v.world, v.ambient), 1.0);
 }
 
 // Leaf blade: half width 0.5 sin(pi y)^0.7 along y in [0, 1]; the signed distance to the edge,
@@ -116,7 +117,7 @@ fn fs_leaf(v: LitOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f
     if (!front) {
         n = -n;
     }
-    let tint = LEAF * (0.85 + 0.3 * v.uv.y);
+    let tint = g.leaf_color.rgb * (0.85 + 0.3 * v.uv.y);
     return vec4<f32>(shade(tint, n, v.world, v.ambient), alpha);
 }
 

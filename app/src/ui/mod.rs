@@ -12,6 +12,7 @@ pub mod touch;
 pub mod widgets;
 
 use egui::{Align2, Color32, RichText, Ui};
+use sylva_core::geometry::Season;
 
 use crate::state::{DesignState, InputEvent};
 
@@ -128,6 +129,17 @@ pub fn sylva_ui(
     let view = ui.available_rect_before_wrap();
     overlays_ui(ui, state, view);
     view
+}
+
+/// The season beside the years slider: one button per season (winter shows deciduous trees
+/// leafless).
+pub(crate) fn season_ui(ui: &mut Ui, season: &mut Season) {
+    ui.horizontal(|ui| {
+        ui.label("Season:");
+        for s in Season::ALL {
+            ui.selectable_value(season, s, s.name());
+        }
+    });
 }
 
 fn side_bar_ui(

@@ -114,6 +114,7 @@ pub fn tree_ui(ui: &mut Ui, params: &mut Parameters, species_names: &[String]) {
                 }
             });
         ui.add(egui::Slider::new(&mut params.years, 1.0..=40.0).text("Age (years)"));
+        super::season_ui(ui, &mut params.season);
     });
     ui.horizontal_wrapped(|ui| {
         ui.label("Crown shape");

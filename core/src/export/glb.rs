@@ -244,7 +244,15 @@ impl<'a> Builder<'a> {
         })
     }
 
-    fn png(&self, what: &'static str, image: &image::RgbaImage) -> Result<Vec<u8>, ExportError> {
+    fn png<P>(
+        &self,
+        what: &'static str,
+        image: &image::ImageBuffer<P, Vec<P::Subpixel>>,
+    ) -> Result<Vec<u8>, ExportError>
+    where
+        P: image::PixelWithColorType,
+        [P::Subpixel]: image::EncodableLayout,
+    {
         png_bytes(image).map_err(|e| ExportError::Encode {
             path: self.path.to_path_buf(),
             what,
@@ -272,7 +280,7 @@ fn build(meshes: &TreeMeshes, path: &Path) -> Result<Vec<u8>, ExportError> {
     let opaque = |c: [f32; 3]| [c[0], c[1], c[2], 1.0];
     let bark_png = builder.png(
         "bark texture",
-        &bark_texture(meshes.colors.bark, TEXTURE_SIZE),
+        &bark_texture(meshes.colors.bark_kind, meshes.colors.bark, TEXTURE_SIZE),
     )?;
     let bark_texture = builder.texture("bark", &bark_png, json::texture::WrappingMode::Repeat);
     let bark = builder.material("bark", Some(bark_texture), [1.0; 4], 0.95, false);
@@ -281,7 +289,7 @@ fn build(meshes: &TreeMeshes, path: &Path) -> Result<Vec<u8>, ExportError> {
     } else {
         let leaf_png = builder.png(
             "leaf texture",
-            &leaf_texture(meshes.colors.leaf, TEXTURE_SIZE),
+            &leaf_texture(meshes.colors.leaf_shape, meshes.colors.leaf, TEXTURE_SIZE),
         )?;
         let texture = builder.texture("leaf", &leaf_png, json::texture::WrappingMode::ClampToEdge);
         let views = builder.vertex_views(&meshes.leaves);

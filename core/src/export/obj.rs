@@ -32,12 +32,12 @@ pub fn write_obj(meshes: &TreeMeshes, path: &Path) -> Result<(), ExportError> {
     let leaf_name = format!("{stem}_leaf.png");
     write_png(
         &sibling(bark_name.clone()),
-        &bark_texture(meshes.colors.bark, TEXTURE_SIZE),
+        &bark_texture(meshes.colors.bark_kind, meshes.colors.bark, TEXTURE_SIZE),
         "bark texture",
     )?;
     write_png(
         &sibling(leaf_name.clone()),
-        &leaf_texture(meshes.colors.leaf, TEXTURE_SIZE),
+        &leaf_texture(meshes.colors.leaf_shape, meshes.colors.leaf, TEXTURE_SIZE),
         "leaf texture",
     )?;
     write_mtl(&sibling(mtl_name.clone()), meshes, &bark_name, &leaf_name)?;
@@ -86,7 +86,15 @@ pub fn write_obj(meshes: &TreeMeshes, path: &Path) -> Result<(), ExportError> {
     write_all(&mut out).map_err(ExportError::io(path))
 }
 
-fn write_png(path: &Path, image: &image::RgbaImage, what: &'static str) -> Result<(), ExportError> {
+fn write_png<P>(
+    path: &Path,
+    image: &image::ImageBuffer<P, Vec<P::Subpixel>>,
+    what: &'static str,
+) -> Result<(), ExportError>
+where
+    P: image::PixelWithColorType,
+    [P::Subpixel]: image::EncodableLayout,
+{
     let bytes = png_bytes(image).map_err(|e| ExportError::Encode {
         path: path.to_path_buf(),
         what,

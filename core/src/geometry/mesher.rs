@@ -94,6 +94,8 @@ impl Mesher {
             bark: params.bark_color,
             leaf: params.leaf_color,
             fruit: params.fruit_color,
+            bark_kind: params.bark_kind,
+            leaf_shape: params.leaf_shape,
         };
     }
 

@@ -41,7 +41,11 @@ use serde::{Deserialize, Serialize};
 use crate::tree::{NodeId, Skeleton};
 
 pub use leaves::{FruitParams, LeafParams};
-pub use looks::{build_tree_level, build_tree_meshes, build_tree_meshes_with, mesh_params_for};
+pub use looks::{
+    BarkKind, BarkLook, FruitLook, LeafShape, Looks, Season, SeasonColors, TreeShade,
+    build_tree_level, build_tree_meshes, build_tree_meshes_in, build_tree_meshes_with,
+    mesh_params_for, mesh_params_in,
+};
 pub use mesher::{Levels, Mesher};
 pub use topology::BranchTopology;
 
@@ -72,6 +76,11 @@ pub struct MeshParams {
     pub bark_color: [f32; 3],
     pub leaf_color: [f32; 3],
     pub fruit_color: [f32; 3],
+    /// Patterns of the bark and leaf textures.
+    #[serde(default)]
+    pub bark_kind: BarkKind,
+    #[serde(default)]
+    pub leaf_shape: LeafShape,
     /// Seed of the leaf order and placement jitter.
     pub seed: u64,
 }
@@ -89,6 +98,8 @@ impl Default for MeshParams {
             bark_color: [0.22, 0.16, 0.11],
             leaf_color: [0.16, 0.36, 0.08],
             fruit_color: [0.65, 0.06, 0.04],
+            bark_kind: BarkKind::default(),
+            leaf_shape: LeafShape::default(),
             seed: 1,
         }
     }
@@ -240,12 +251,16 @@ impl Lod {
     }
 }
 
-/// Colours of the materials, linear RGB.
+/// Colours of the materials, linear RGB, and the patterns of their textures.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Serialize, Deserialize)]
 pub struct MaterialColors {
     pub bark: [f32; 3],
     pub leaf: [f32; 3],
     pub fruit: [f32; 3],
+    #[serde(default)]
+    pub bark_kind: BarkKind,
+    #[serde(default)]
+    pub leaf_shape: LeafShape,
 }
 
 /// Every mesh of a tree: branches per level of detail, one randomly ordered leaf buffer and one

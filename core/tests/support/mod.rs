@@ -190,3 +190,10 @@ pub fn mean_rise(tree: &sylva_core::Tree, orders: std::ops::RangeInclusive<u32>)
         .collect();
     rises.iter().sum::<f32>() / rises.len().max(1) as f32
 }
+
+/// The median of `values` (the upper one of an even count), as the suite holds presets over
+/// seeds.
+pub fn median(mut values: Vec<f32>) -> f32 {
+    values.sort_by(f32::total_cmp);
+    values[values.len() / 2]
+}
