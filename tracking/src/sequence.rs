@@ -414,7 +414,9 @@ pub fn parse_poses(text: &str, path: &Path) -> Result<Vec<TimedPose>, SequenceEr
             let v = &row.values;
             let rotation = DQuat::from_xyzw(v[3], v[4], v[5], v[6]);
             let length = rotation.length();
-            if !((length - 1.0).abs() <= QUATERNION_LENGTH_TOLERANCE) {
+            // Written so that a NaN length fails too.
+            let unit = (length - 1.0).abs() <= QUATERNION_LENGTH_TOLERANCE;
+            if !unit {
                 return Err(SequenceError::Parse {
                     path: path.to_path_buf(),
                     line: row.line,
