@@ -92,12 +92,16 @@ pub fn track(args: TrackArgs) -> anyhow::Result<()> {
             bar.set_length(total as u64);
             bar.set_position(done as u64);
         },
+        // To stderr whatever it is (a terminal, a pipe, a log file): the bar's own println
+        // prints nothing when its output is hidden.
         |skip| {
-            bar.println(format!(
-                "warning: skipped frame {}: {}",
-                skip.path.display(),
-                skip.reason
-            ))
+            bar.suspend(|| {
+                eprintln!(
+                    "warning: skipped frame {}: {}",
+                    skip.path.display(),
+                    skip.reason
+                )
+            })
         },
     )
     .with_context(|| format!("tracking {}", args.sequence.display()))?;
@@ -124,6 +128,15 @@ pub fn track(args: TrackArgs) -> anyhow::Result<()> {
     if let Some(path) = &args.report {
         let json = serde_json::to_string_pretty(&report).context("encoding the report")?;
         std::fs::write(path, json).with_context(|| format!("writing {}", path.display()))?;
+    }
+    if report.tracked_frames == 0 {
+        println!("{}", report.summary_line());
+        anyhow::bail!(
+            "no frame of {} was tracked ({} frames, {} unreadable): the figures above measure nothing",
+            args.sequence.display(),
+            report.frames,
+            report.skipped.len()
+        );
     }
     if let Some(path) = &args.plot {
         crate::track_plot::draw(&report, path)

@@ -8,9 +8,18 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, bail};
-use glam::{Mat4, Quat, Vec3};
+use glam::{DMat4, Mat4};
+use sylva_tracking::TumSequence;
+use sylva_tracking::input_file::{decode_image, decode_limits};
+use sylva_tracking::sequence::{decode_depth_m, nearest, read_image_file};
 
+use crate::live::intrinsics_of;
 use crate::render::Intrinsics;
+
+/// Largest time gap when pairing a frame with a depth map or a ground-truth pose, seconds.
+const MAX_PAIRING_GAP_S: f64 = 0.02;
+/// Depth units per metre when `camera.txt` gives none (TUM's 5000).
+const DEFAULT_DEPTH_SCALE: f64 = 5000.0;
 
 /// One frame of footage.
 #[derive(Clone, Debug, PartialEq)]
@@ -32,86 +41,32 @@ pub struct Footage {
     pub frames: Vec<FootageFrame>,
 }
 
-fn read_lines(path: &Path) -> anyhow::Result<Vec<Vec<String>>> {
-    let text =
-        std::fs::read_to_string(path).with_context(|| format!("cannot read {}", path.display()))?;
-    Ok(text
-        .lines()
-        .map(str::trim)
-        .filter(|l| !l.is_empty() && !l.starts_with('#'))
-        .map(|l| l.split_whitespace().map(str::to_owned).collect())
-        .collect())
-}
-
-fn number<T: std::str::FromStr>(path: &Path, line: usize, field: &str) -> anyhow::Result<T> {
-    field.parse().map_err(|_| {
-        anyhow::anyhow!(
-            "{}: entry {line}: `{field}` is not a number",
-            path.display()
-        )
-    })
-}
-
 impl Footage {
-    /// Opens a TUM-layout folder.
+    /// Opens a TUM-layout folder through the tracking crate's validated readers
+    /// ([`TumSequence::open`]): the camera file, frame lists and ground truth are checked there
+    /// (finite numbers, positive focal lengths, sizes a texture can hold, increasing timestamps,
+    /// unit quaternions, regular files of bounded size), once for the whole app.
     pub fn open(root: &Path) -> anyhow::Result<Footage> {
-        let camera_path = root.join("camera.txt");
-        let mut values = std::collections::HashMap::new();
-        for (i, fields) in read_lines(&camera_path)?.iter().enumerate() {
-            if let [key, value, ..] = fields.as_slice() {
-                values.insert(key.clone(), number::<f32>(&camera_path, i, value)?);
-            }
-        }
-        let get = |key: &str| {
-            values
-                .get(key)
-                .copied()
-                .with_context(|| format!("{}: missing `{key}`", camera_path.display()))
-        };
-        let intrinsics = Intrinsics {
-            width: get("width")? as u32,
-            height: get("height")? as u32,
-            fx: get("fx")?,
-            fy: get("fy")?,
-            cx: get("cx")?,
-            cy: get("cy")?,
-            distortion: ["k1", "k2", "p1", "p2", "k3"]
-                .map(|k| values.get(k).copied().unwrap_or(0.0)),
-        };
-        let depth_scale = values.get("depth_scale").copied().unwrap_or(5000.0);
-        let timed = |name: &str| -> anyhow::Result<Vec<(f64, PathBuf)>> {
-            let path = root.join(name);
-            if !path.exists() {
-                return Ok(Vec::new());
-            }
-            read_lines(&path)?
-                .iter()
-                .enumerate()
-                .map(|(i, f)| match f.as_slice() {
-                    [t, file, ..] => Ok((number(&path, i, t)?, root.join(file))),
-                    _ => bail!("{}: entry {i}: expected `timestamp file`", path.display()),
-                })
-                .collect()
-        };
-        let rgb = timed("rgb.txt")?;
-        if rgb.is_empty() {
-            bail!("{}: no frames listed in rgb.txt", root.display());
-        }
-        let depth = timed("depth.txt")?;
-        let poses = read_poses(&root.join("groundtruth.txt"))?;
-        let frames = rgb
-            .into_iter()
-            .map(|(time_s, rgb)| FootageFrame {
-                time_s,
-                depth: nearest(&depth, time_s, 0.02).map(|d| d.1.clone()),
-                world_from_camera: nearest(&poses, time_s, 0.02).map(|p| p.1),
-                rgb,
+        let sequence = TumSequence::open(root)
+            .with_context(|| format!("cannot open footage {}", root.display()))?;
+        let frames = sequence
+            .frames
+            .iter()
+            .map(|f| FootageFrame {
+                time_s: f.timestamp_s,
+                rgb: f.path.clone(),
+                depth: nearest(&sequence.depth, f.timestamp_s, |d| d.timestamp_s)
+                    .filter(|d| (d.timestamp_s - f.timestamp_s).abs() <= MAX_PAIRING_GAP_S)
+                    .map(|d| d.path.clone()),
+                world_from_camera: sequence
+                    .groundtruth_at(f.timestamp_s, MAX_PAIRING_GAP_S)
+                    .map(|pose| DMat4::from(pose).as_mat4()),
             })
             .collect();
         Ok(Footage {
             root: root.to_owned(),
-            intrinsics,
-            depth_scale,
+            intrinsics: intrinsics_of(&sequence.camera),
+            depth_scale: sequence.camera.depth_scale.unwrap_or(DEFAULT_DEPTH_SCALE) as f32,
             frames,
         })
     }
@@ -124,15 +79,31 @@ impl Footage {
         self.frames.is_empty()
     }
 
-    /// The colour image of frame `index`, RGBA8.
+    /// The colour image of frame `index`, RGBA8: a complete image file of bounded size, of
+    /// the camera's size (anything else is an error naming the file, never a blank frame).
     pub fn load_rgba(&self, index: usize) -> anyhow::Result<image::RgbaImage> {
         let frame = self
             .frames
             .get(index)
             .with_context(|| format!("{}: no frame {index}", self.root.display()))?;
-        Ok(image::open(&frame.rgb)
-            .with_context(|| format!("cannot decode {}", frame.rgb.display()))?
-            .to_rgba8())
+        let (width, height) = (self.intrinsics.width, self.intrinsics.height);
+        let decoded = read_image_file(&frame.rgb)
+            .and_then(|bytes| decode_image(&bytes, decode_limits(width, height)))
+            .map_err(|reason| {
+                anyhow::anyhow!(
+                    "cannot decode frame {index}, {}: {reason} (the camera says {width} x {height})",
+                    frame.rgb.display()
+                )
+            })?;
+        if (decoded.width(), decoded.height()) != (width, height) {
+            bail!(
+                "frame {index}, {}: image is {} x {}, the camera says {width} x {height}",
+                frame.rgb.display(),
+                decoded.width(),
+                decoded.height()
+            );
+        }
+        Ok(decoded.to_rgba8())
     }
 
     /// The depth map of frame `index` in metres (0 = no measurement), if the footage has one.
@@ -140,53 +111,10 @@ impl Footage {
         let Some(path) = self.frames.get(index).and_then(|f| f.depth.as_ref()) else {
             return Ok(None);
         };
-        let image = image::open(path)
-            .with_context(|| format!("cannot decode {}", path.display()))?
-            .to_luma16();
-        let scale = 1.0 / self.depth_scale;
-        let (w, h) = image.dimensions();
-        Ok(Some((
-            w,
-            h,
-            image.pixels().map(|p| p.0[0] as f32 * scale).collect(),
-        )))
+        let depth = decode_depth_m(path, f64::from(self.depth_scale))
+            .map_err(|reason| anyhow::anyhow!("cannot decode {}: {reason}", path.display()))?;
+        Ok(Some(depth))
     }
-}
-
-fn read_poses(path: &Path) -> anyhow::Result<Vec<(f64, Mat4)>> {
-    if !path.exists() {
-        return Ok(Vec::new());
-    }
-    read_lines(path)?
-        .iter()
-        .enumerate()
-        .map(|(i, f)| {
-            if f.len() < 8 {
-                bail!(
-                    "{}: entry {i}: expected `t tx ty tz qx qy qz qw`",
-                    path.display()
-                );
-            }
-            let v: Vec<f64> = f[..8]
-                .iter()
-                .map(|x| number(path, i, x))
-                .collect::<anyhow::Result<_>>()?;
-            let rotation =
-                Quat::from_xyzw(v[4] as f32, v[5] as f32, v[6] as f32, v[7] as f32).normalize();
-            let translation = Vec3::new(v[1] as f32, v[2] as f32, v[3] as f32);
-            Ok((v[0], Mat4::from_rotation_translation(rotation, translation)))
-        })
-        .collect()
-}
-
-fn nearest<T>(items: &[(f64, T)], t: f64, max_gap_s: f64) -> Option<&(f64, T)> {
-    let i = items.partition_point(|(ti, _)| *ti < t);
-    [i.checked_sub(1), Some(i)]
-        .into_iter()
-        .flatten()
-        .filter_map(|j| items.get(j))
-        .filter(|(ti, _)| (ti - t).abs() <= max_gap_s)
-        .min_by(|a, b| (a.0 - t).abs().total_cmp(&(b.0 - t).abs()))
 }
 
 #[cfg(test)]
@@ -194,15 +122,8 @@ mod tests {
     use super::*;
 
     #[test]
-    fn nearest_pose_is_found_within_the_gap_only() {
-        let items = vec![(1.0, 'a'), (2.0, 'b'), (3.0, 'c')];
-        assert_eq!(nearest(&items, 2.01, 0.02).map(|x| x.1), Some('b'));
-        assert_eq!(nearest(&items, 2.5, 0.02), None);
-    }
-
-    #[test]
-    fn a_missing_folder_is_an_error_naming_the_file() {
+    fn a_missing_folder_is_an_error_naming_it() {
         let err = Footage::open(Path::new("/nonexistent/seq")).expect_err("must fail");
-        assert!(format!("{err:#}").contains("camera.txt"));
+        assert!(format!("{err:#}").contains("/nonexistent/seq"), "{err:#}");
     }
 }

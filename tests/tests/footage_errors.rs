@@ -108,3 +108,182 @@ fn a_missing_sequence_or_frame_list_is_an_error() {
         "{text}"
     );
 }
+
+/// Issue 21: `path` made a named pipe (FIFO) in place of whatever was there.
+#[cfg(unix)]
+fn make_fifo(path: &Path) {
+    let _ = fs::remove_file(path);
+    let status = std::process::Command::new("mkfifo")
+        .arg(path)
+        .status()
+        .expect("mkfifo runs");
+    assert!(status.success(), "mkfifo {}", path.display());
+}
+
+/// Runs `f` on a thread and fails (instead of hanging the suite) if it takes over a minute.
+fn within_a_minute<T: Send + 'static>(what: &str, f: impl FnOnce() -> T + Send + 'static) -> T {
+    let (sender, receiver) = std::sync::mpsc::channel();
+    std::thread::spawn(move || sender.send(f()));
+    receiver
+        .recv_timeout(std::time::Duration::from_secs(60))
+        .unwrap_or_else(|_| panic!("{what} hung for a minute"))
+}
+
+#[cfg(unix)]
+#[test]
+fn a_fifo_frame_is_skipped_naming_it_without_hanging_the_run() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let files = copy_head(dir.path(), 40);
+    make_fifo(&dir.path().join(&files[10]));
+    let root = dir.path().to_path_buf();
+    let (report, warnings) = within_a_minute("tracking past a FIFO frame", move || {
+        let mut warnings = Vec::new();
+        let report = run_sequence(
+            &root,
+            TrackerConfig::default(),
+            |_, _| {},
+            |s| warnings.push(format!("{}: {}", s.path.display(), s.reason)),
+        );
+        (report.map(|r| r.frames), warnings)
+    });
+    assert_eq!(report.expect("the run goes on"), 40);
+    assert!(
+        warnings
+            .iter()
+            .any(|w| w.contains(&files[10]) && w.contains("FIFO")),
+        "{warnings:?}"
+    );
+}
+
+#[cfg(unix)]
+#[test]
+fn fifo_or_device_lists_and_camera_files_are_refused_naming_them() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    copy_head(dir.path(), 5);
+    let root = dir.path().to_path_buf();
+    // Each file in turn becomes a FIFO or `/dev/zero`; opening the sequence must refuse it
+    // at once, naming it (a FIFO would block the reader, /dev/zero would fill the memory).
+    for name in [
+        "camera.txt",
+        "rgb.txt",
+        "groundtruth.txt",
+        "accelerometer.txt",
+    ] {
+        let path = root.join(name);
+        let saved = fs::read(&path).expect("saved copy");
+        for device in [false, true] {
+            if device {
+                let _ = fs::remove_file(&path);
+                std::os::unix::fs::symlink("/dev/zero", &path).expect("symlink");
+            } else {
+                make_fifo(&path);
+            }
+            let opened = root.clone();
+            let text = within_a_minute(name, move || {
+                TumSequence::open(&opened)
+                    .map(|_| ())
+                    .unwrap_err()
+                    .to_string()
+            });
+            let expected = if device { "device" } else { "FIFO" };
+            assert!(
+                text.contains(name) && text.contains(expected),
+                "{name}: {text}"
+            );
+        }
+        fs::remove_file(&path).expect("remove");
+        fs::write(&path, saved).expect("restore");
+    }
+}
+
+#[test]
+fn a_list_over_the_size_limit_is_refused_naming_it() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    copy_head(dir.path(), 5);
+    let list = dir.path().join("groundtruth.txt");
+    // Sparse: larger than the limit without using the disk.
+    fs::File::options()
+        .write(true)
+        .open(&list)
+        .expect("open")
+        .set_len(sylva_tracking::input_file::MAX_LIST_FILE_BYTES + 1)
+        .expect("grow");
+    let text = TumSequence::open(dir.path()).unwrap_err().to_string();
+    assert!(
+        text.contains("groundtruth.txt") && text.contains("larger than"),
+        "{text}"
+    );
+}
+
+#[test]
+fn repeated_timestamps_in_a_frame_list_or_the_ground_truth_are_errors_naming_the_line() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    copy_head(dir.path(), 5);
+    for name in ["rgb.txt", "groundtruth.txt"] {
+        let path = dir.path().join(name);
+        let saved = fs::read_to_string(&path).expect("read");
+        let rows: Vec<&str> = saved
+            .lines()
+            .filter(|l| !l.trim().is_empty() && !l.starts_with('#'))
+            .collect();
+        // The third row's timestamp repeated on the next line.
+        let stamp = rows[2].split_whitespace().next().expect("timestamp");
+        let rest: Vec<&str> = rows[3].split_whitespace().skip(1).collect();
+        let mut damaged: Vec<String> = rows.iter().map(|r| r.to_string()).collect();
+        damaged[3] = format!("{stamp} {}", rest.join(" "));
+        fs::write(&path, damaged.join("\n")).expect("write");
+        let text = TumSequence::open(dir.path()).unwrap_err().to_string();
+        assert!(
+            text.contains(name) && text.contains("line 4") && text.contains("repeats"),
+            "{name}: {text}"
+        );
+        fs::write(&path, saved).expect("restore");
+    }
+}
+
+#[test]
+fn zero_or_nan_ground_truth_quaternions_are_errors_naming_the_line() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    copy_head(dir.path(), 5);
+    let path = dir.path().join("groundtruth.txt");
+    let saved = fs::read_to_string(&path).expect("read");
+    for quaternion in ["0 0 0 0", "nan 0 0 1"] {
+        let mut lines: Vec<String> = saved.lines().map(str::to_owned).collect();
+        let index = lines
+            .iter()
+            .position(|l| !l.starts_with('#'))
+            .expect("a row")
+            + 1;
+        let words: Vec<&str> = lines[index].split_whitespace().take(4).collect();
+        lines[index] = format!("{} {quaternion}", words.join(" "));
+        fs::write(&path, lines.join("\n")).expect("write");
+        let text = TumSequence::open(dir.path()).unwrap_err().to_string();
+        assert!(
+            text.contains("groundtruth.txt") && text.contains(&format!("line {}", index + 1)),
+            "{quaternion}: {text}"
+        );
+    }
+}
+
+#[test]
+fn a_sequence_whose_every_frame_is_unreadable_is_an_error_not_a_report() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let files = copy_head(dir.path(), 6);
+    for file in &files {
+        fs::write(dir.path().join(file), b"not an image").expect("corrupt");
+    }
+    let mut skipped = 0;
+    let err = run_sequence(
+        dir.path(),
+        TrackerConfig::default(),
+        |_, _| {},
+        |_| skipped += 1,
+    )
+    .expect_err("nothing to measure");
+    assert_eq!(skipped, 6);
+    let text = err.to_string();
+    assert!(
+        text.contains("no frame") && text.contains("6 listed"),
+        "{text}"
+    );
+}

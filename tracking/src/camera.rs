@@ -3,6 +3,7 @@
 //! Tracking undistorts *points*, never whole images: corners are found and followed in the raw
 //! image, then mapped to normalised (undistorted) coordinates `x = (X/Z, Y/Z)` for geometry.
 
+use crate::input_file::{MAX_CAMERA_FILE_BYTES, read_regular_text};
 use glam::{DVec2, DVec3};
 use std::path::{Path, PathBuf};
 
@@ -28,6 +29,9 @@ pub enum CameraError {
 
 /// The longest image side a camera file may give, pixels (beyond any phone or video camera).
 pub const MAX_IMAGE_SIDE: u32 = 16384;
+
+/// The highest frame rate a camera file may give, frames per second.
+pub const MAX_FRAME_RATE_HZ: f64 = 10_000.0;
 
 /// Intrinsics of a pinhole camera with radial-tangential distortion.
 #[derive(Clone, Copy, Debug, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -63,12 +67,14 @@ impl Camera {
     }
 
     /// Reads a `camera.txt`: one `key value` per line, `#` comments; keys `width height fx fy cx
-    /// cy` are required, `k1 k2 p1 p2 k3 depth_scale frame_rate_hz` optional.
+    /// cy` are required, `k1 k2 p1 p2 k3 depth_scale frame_rate_hz` optional. Only a regular
+    /// file of at most [`MAX_CAMERA_FILE_BYTES`] is read.
     pub fn from_file(path: &Path) -> Result<Self, CameraError> {
-        let text = std::fs::read_to_string(path).map_err(|source| CameraError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text =
+            read_regular_text(path, MAX_CAMERA_FILE_BYTES).map_err(|source| CameraError::Io {
+                path: path.to_path_buf(),
+                source,
+            })?;
         Self::parse(&text, path)
     }
 
@@ -148,6 +154,12 @@ impl Camera {
         if depth_scale.is_some_and(|s| s <= 0.0) {
             return Err(invalid("depth_scale must be positive".into()));
         }
+        let frame_rate_hz = get("frame_rate_hz");
+        if frame_rate_hz.is_some_and(|r| !(r > 0.0 && r <= MAX_FRAME_RATE_HZ)) {
+            return Err(invalid(format!(
+                "frame_rate_hz must be above 0 and at most {MAX_FRAME_RATE_HZ}"
+            )));
+        }
         Ok(Self {
             width: width as u32,
             height: height as u32,
@@ -157,7 +169,7 @@ impl Camera {
             cy: required("cy")?,
             distortion,
             depth_scale,
-            frame_rate_hz: get("frame_rate_hz"),
+            frame_rate_hz,
         })
     }
 
@@ -239,6 +251,7 @@ impl Camera {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use proptest::prelude::*;
 
     fn fr1() -> Camera {
         let mut camera = Camera::pinhole(640, 480, 517.3, 516.5, 318.6, 255.3);
@@ -277,5 +290,76 @@ mod tests {
     fn negative_focal_length_is_rejected() {
         let text = "width 640\nheight 480\nfx -1\nfy 500\ncx 1\ncy 1";
         assert!(Camera::parse(text, Path::new("c.txt")).is_err());
+    }
+
+    #[test]
+    fn a_frame_rate_of_zero_is_rejected() {
+        let text = "width 640\nheight 480\nfx 500\nfy 500\ncx 1\ncy 1\nframe_rate_hz 0";
+        let err = Camera::parse(text, Path::new("c.txt")).expect_err("zero frame rate");
+        assert!(err.to_string().contains("frame_rate_hz"), "{err}");
+    }
+
+    /// Cases per property: 2000, or `PROPTEST_CASES` (the README's long fuzzing run).
+    fn config() -> ProptestConfig {
+        let cases = std::env::var("PROPTEST_CASES")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(2000);
+        ProptestConfig {
+            cases,
+            ..Default::default()
+        }
+    }
+
+    /// What every accepted camera must satisfy.
+    fn check(text: &str) {
+        if let Ok(c) = Camera::parse(text, Path::new("camera.txt")) {
+            assert!((1..=MAX_IMAGE_SIDE).contains(&c.width), "{c:?}");
+            assert!((1..=MAX_IMAGE_SIDE).contains(&c.height), "{c:?}");
+            assert!(c.fx.is_finite() && c.fx > 0.0 && c.fy.is_finite() && c.fy > 0.0);
+            assert!(c.cx.is_finite() && c.cy.is_finite());
+            assert!(c.distortion.iter().all(|k| k.is_finite()));
+            assert!(c.depth_scale.is_none_or(|s| s.is_finite() && s > 0.0));
+            assert!(
+                c.frame_rate_hz
+                    .is_none_or(|r| r > 0.0 && r <= MAX_FRAME_RATE_HZ)
+            );
+        }
+    }
+
+    proptest! {
+        #![proptest_config(config())]
+
+        #[test]
+        fn the_camera_parser_never_panics_on_arbitrary_bytes(
+            bytes in proptest::collection::vec(any::<u8>(), 0..600)
+        ) {
+            check(&String::from_utf8_lossy(&bytes));
+        }
+
+        #[test]
+        fn every_camera_the_parser_accepts_is_valid(
+            lines in proptest::collection::vec(
+                (
+                    proptest::sample::select(vec![
+                        "width", "height", "fx", "fy", "cx", "cy", "k1", "k2", "p1", "p2",
+                        "k3", "depth_scale", "frame_rate_hz", "#", "other",
+                    ]),
+                    prop_oneof![
+                        any::<f64>().prop_map(|x| x.to_string()),
+                        (0u32..20000).prop_map(|x| x.to_string()),
+                        proptest::sample::select(vec![
+                            "nan", "inf", "-inf", "1e400", "-0", "0", "0.5", "16384", "16385",
+                            "640", "", "x",
+                        ])
+                        .prop_map(str::to_owned),
+                    ],
+                ),
+                0..20,
+            )
+        ) {
+            let text: Vec<String> = lines.iter().map(|(k, v)| format!("{k} {v}")).collect();
+            check(&text.join("\n"));
+        }
     }
 }

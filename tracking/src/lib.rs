@@ -19,6 +19,7 @@ pub mod camera;
 pub mod features;
 pub mod frame;
 pub mod ground_plane;
+pub mod input_file;
 pub mod linalg;
 pub mod lk;
 pub mod map;

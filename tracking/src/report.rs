@@ -25,6 +25,11 @@ pub enum RunError {
     Tracker(#[from] TrackerError),
     #[error(transparent)]
     Scale(#[from] RunScaleError),
+    /// Every listed frame was unreadable: there is nothing to track or to measure.
+    #[error(
+        "no frame of {path} could be read ({num_skipped} listed, all skipped): nothing was tracked"
+    )]
+    NoFrameRead { path: PathBuf, num_skipped: usize },
 }
 
 /// A frame the source could not read.
@@ -169,6 +174,12 @@ pub fn run_sequence_scaled(
             }
         }
         progress(done, total);
+    }
+    if outputs.is_empty() {
+        return Err(RunError::NoFrameRead {
+            path: root.to_path_buf(),
+            num_skipped: skipped.len(),
+        });
     }
     let scale = run_scale(&outputs, &sequence.camera, num_frames, options)?;
     Ok(summarise(

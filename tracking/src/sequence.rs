@@ -4,9 +4,17 @@
 //! [`Camera::from_file`]) and optionally `groundtruth.txt` (`timestamp tx ty tz qx qy qz qw`,
 //! `world_from_camera`), `depth.txt` and `accelerometer.txt` (`timestamp ax ay az`).
 //! Unreadable frames are skipped and reported as [`SourceEvent::Skipped`], naming the file.
+//!
+//! Every reader opens only regular files and caps what it reads ([`crate::input_file`]); list
+//! timestamps must increase strictly, line by line, and ground-truth quaternions must be unit
+//! length, so a damaged list is an error naming its line rather than a figure computed from it.
 
 use crate::camera::{Camera, CameraError};
 use crate::frame::{Frame, GrayImage};
+use crate::input_file::{
+    self, MAX_IMAGE_FILE_BYTES, MAX_LIST_FILE_BYTES, decode_image, decode_limits,
+    read_regular_file, read_regular_text,
+};
 use glam::{DAffine3, DQuat, DVec3};
 use std::path::{Path, PathBuf};
 
@@ -104,21 +112,14 @@ impl TumSequence {
         if frames.is_empty() {
             return Err(SequenceError::Empty { path: rgb_list });
         }
+        // A listed name that is there but is not a readable regular file is an error, not
+        // footage without that part.
         let optional = |name: &str| {
             let path = root.join(name);
-            path.is_file().then_some(path)
+            input_file::exists(&path).then_some(path)
         };
         let groundtruth = match optional("groundtruth.txt") {
-            Some(path) => read_rows(&path, 8)?
-                .into_iter()
-                .map(|(t, v)| TimedPose {
-                    timestamp_s: t,
-                    world_from_camera: DAffine3::from_rotation_translation(
-                        DQuat::from_xyzw(v[3], v[4], v[5], v[6]).normalize(),
-                        DVec3::new(v[0], v[1], v[2]),
-                    ),
-                })
-                .collect(),
+            Some(path) => read_poses(&path)?,
             None => Vec::new(),
         };
         let depth = match optional("depth.txt") {
@@ -128,9 +129,9 @@ impl TumSequence {
         let accelerometer = match optional("accelerometer.txt") {
             Some(path) => read_rows(&path, 4)?
                 .into_iter()
-                .map(|(t, v)| TimedVector {
-                    timestamp_s: t,
-                    value: DVec3::new(v[0], v[1], v[2]),
+                .map(|row| TimedVector {
+                    timestamp_s: row.timestamp_s,
+                    value: DVec3::new(row.values[0], row.values[1], row.values[2]),
                 })
                 .collect(),
             None => Vec::new(),
@@ -263,9 +264,9 @@ impl FrameSource for FileListSource {
 
 /// Decodes an image file to grey, checking its size against the camera.
 pub fn decode_gray(path: &Path, camera: &Camera) -> Result<GrayImage, String> {
-    let bytes = std::fs::read(path).map_err(|e| e.to_string())?;
-    check_complete(&bytes)?;
-    let decoded = image::load_from_memory(&bytes).map_err(|e| e.to_string())?;
+    let bytes = read_image_file(path)?;
+    let decoded = decode_image(&bytes, decode_limits(camera.width, camera.height))
+        .map_err(|e| format!("{e} (the camera says {} x {})", camera.width, camera.height))?;
     let gray = decoded.to_luma8();
     if gray.width() != camera.width || gray.height() != camera.height {
         return Err(format!(
@@ -278,6 +279,14 @@ pub fn decode_gray(path: &Path, camera: &Camera) -> Result<GrayImage, String> {
     }
     let (width, height) = gray.dimensions();
     GrayImage::from_pixels(width, height, gray.into_raw()).ok_or_else(|| "bad pixel buffer".into())
+}
+
+/// The bytes of an image file (a regular file of at most [`MAX_IMAGE_FILE_BYTES`]), checked
+/// to be complete.
+pub fn read_image_file(path: &Path) -> Result<Vec<u8>, String> {
+    let bytes = read_regular_file(path, MAX_IMAGE_FILE_BYTES).map_err(|e| e.to_string())?;
+    check_complete(&bytes)?;
+    Ok(bytes)
 }
 
 /// Decoders accept cut-off JPEGs (grey below the cut); a complete JPEG ends with the EOI
@@ -296,8 +305,9 @@ fn check_complete(bytes: &[u8]) -> Result<(), String> {
 
 /// Decodes a 16-bit depth map to metres (0 where there is no measurement).
 pub fn decode_depth_m(path: &Path, depth_scale: f64) -> Result<(u32, u32, Vec<f32>), String> {
-    let bytes = std::fs::read(path).map_err(|e| e.to_string())?;
-    let decoded = image::load_from_memory(&bytes).map_err(|e| e.to_string())?;
+    let bytes = read_image_file(path)?;
+    let side = crate::camera::MAX_IMAGE_SIDE;
+    let decoded = decode_image(&bytes, decode_limits(side, side))?;
     let depth = decoded.to_luma16();
     let (w, h) = depth.dimensions();
     let metres = depth
@@ -308,16 +318,59 @@ pub fn decode_depth_m(path: &Path, depth_scale: f64) -> Result<(u32, u32, Vec<f3
 }
 
 fn read_text(path: &Path) -> Result<String, SequenceError> {
-    std::fs::read_to_string(path).map_err(|source| SequenceError::Io {
+    read_regular_text(path, MAX_LIST_FILE_BYTES).map_err(|source| SequenceError::Io {
         path: path.to_path_buf(),
         source,
     })
 }
 
-/// Rows of `timestamp v1 .. v(n-1)`, skipping comments and blank lines.
-fn read_rows(path: &Path, columns: usize) -> Result<Vec<(f64, Vec<f64>)>, SequenceError> {
-    let text = read_text(path)?;
+/// One row of a timestamped list: its timestamp, the other numbers, and its line (from 1).
+#[derive(Clone, Debug, PartialEq)]
+pub struct Row {
+    pub timestamp_s: f64,
+    pub values: Vec<f64>,
+    pub line: usize,
+}
+
+/// Checks that each row's timestamp follows the previous row's.
+struct Increasing<'a> {
+    path: &'a Path,
+    previous_s: Option<f64>,
+}
+
+impl Increasing<'_> {
+    fn check(&mut self, timestamp_s: f64, line: usize) -> Result<(), SequenceError> {
+        if let Some(previous_s) = self.previous_s
+            && timestamp_s <= previous_s
+        {
+            let what = if timestamp_s == previous_s {
+                "repeats"
+            } else {
+                "goes back from"
+            };
+            return Err(SequenceError::Parse {
+                path: self.path.to_path_buf(),
+                line,
+                problem: format!(
+                    "timestamp {timestamp_s} {what} the previous one ({previous_s}); \
+                     timestamps must increase"
+                ),
+            });
+        }
+        self.previous_s = Some(timestamp_s);
+        Ok(())
+    }
+}
+
+/// Rows of `timestamp v1 .. v(n-1)` from `text` (the contents of `path`, which only names the
+/// file in errors), skipping comments and blank lines. Every number must be finite and the
+/// timestamps must increase.
+pub fn parse_rows(text: &str, path: &Path, columns: usize) -> Result<Vec<Row>, SequenceError> {
     let mut rows = Vec::new();
+    let mut increasing = Increasing {
+        path,
+        previous_s: None,
+    };
     for (index, line) in text.lines().enumerate() {
         let line = line.trim();
         if line.is_empty() || line.starts_with('#') {
@@ -326,25 +379,80 @@ fn read_rows(path: &Path, columns: usize) -> Result<Vec<(f64, Vec<f64>)>, Sequen
         let parsed: Result<Vec<f64>, _> = line.split_whitespace().map(str::parse::<f64>).collect();
         match parsed {
             Ok(values) if values.len() == columns && values.iter().all(|v| v.is_finite()) => {
-                rows.push((values[0], values[1..].to_vec()))
+                increasing.check(values[0], index + 1)?;
+                rows.push(Row {
+                    timestamp_s: values[0],
+                    values: values[1..].to_vec(),
+                    line: index + 1,
+                });
             }
             _ => {
                 return Err(SequenceError::Parse {
                     path: path.to_path_buf(),
                     line: index + 1,
-                    problem: format!("expected {columns} numbers, found `{line}`"),
+                    problem: format!("expected {columns} finite numbers, found `{line}`"),
                 });
             }
         }
     }
-    rows.sort_by(|a, b| a.0.total_cmp(&b.0));
     Ok(rows)
 }
 
-/// A `timestamp relative/path` list.
-fn read_file_list(root: &Path, list: &Path) -> Result<Vec<TimedFile>, SequenceError> {
-    let text = read_text(list)?;
+fn read_rows(path: &Path, columns: usize) -> Result<Vec<Row>, SequenceError> {
+    parse_rows(&read_text(path)?, path, columns)
+}
+
+/// Largest distance of a ground-truth quaternion's length from 1.
+pub const QUATERNION_LENGTH_TOLERANCE: f64 = 0.1;
+
+/// Poses of `groundtruth.txt` (`timestamp tx ty tz qx qy qz qw`) from `text`; a quaternion
+/// that is not of unit length (zero, say) is an error naming its line.
+pub fn parse_poses(text: &str, path: &Path) -> Result<Vec<TimedPose>, SequenceError> {
+    parse_rows(text, path, 8)?
+        .into_iter()
+        .map(|row| {
+            let v = &row.values;
+            let rotation = DQuat::from_xyzw(v[3], v[4], v[5], v[6]);
+            let length = rotation.length();
+            // Written so that a NaN length fails too.
+            let unit = (length - 1.0).abs() <= QUATERNION_LENGTH_TOLERANCE;
+            if !unit {
+                return Err(SequenceError::Parse {
+                    path: path.to_path_buf(),
+                    line: row.line,
+                    problem: format!(
+                        "quaternion ({}, {}, {}, {}) has length {length}, not 1",
+                        v[3], v[4], v[5], v[6]
+                    ),
+                });
+            }
+            Ok(TimedPose {
+                timestamp_s: row.timestamp_s,
+                world_from_camera: DAffine3::from_rotation_translation(
+                    rotation.normalize(),
+                    DVec3::new(v[0], v[1], v[2]),
+                ),
+            })
+        })
+        .collect()
+}
+
+fn read_poses(path: &Path) -> Result<Vec<TimedPose>, SequenceError> {
+    parse_poses(&read_text(path)?, path)
+}
+
+/// A `timestamp relative/path` list from `text` (the contents of `list`; paths are relative
+/// to `root`); timestamps must be finite and increase.
+pub fn parse_file_list(
+    text: &str,
+    root: &Path,
+    list: &Path,
+) -> Result<Vec<TimedFile>, SequenceError> {
     let mut files = Vec::new();
+    let mut increasing = Increasing {
+        path: list,
+        previous_s: None,
+    };
     for (index, line) in text.lines().enumerate() {
         let line = line.trim();
         if line.is_empty() || line.starts_with('#') {
@@ -366,10 +474,151 @@ fn read_file_list(root: &Path, list: &Path) -> Result<Vec<TimedFile>, SequenceEr
                 problem: format!("expected `timestamp path`, found `{line}`"),
             });
         };
+        increasing.check(timestamp_s, index + 1)?;
         files.push(TimedFile {
             timestamp_s,
             path: root.join(relative),
         });
     }
     Ok(files)
+}
+
+fn read_file_list(root: &Path, list: &Path) -> Result<Vec<TimedFile>, SequenceError> {
+    parse_file_list(&read_text(list)?, root, list)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use proptest::collection::vec;
+    use proptest::prelude::*;
+
+    /// Cases per property: 2000, or `PROPTEST_CASES` (the README's long fuzzing run).
+    fn config() -> ProptestConfig {
+        let cases = std::env::var("PROPTEST_CASES")
+            .ok()
+            .and_then(|v| v.parse().ok())
+            .unwrap_or(2000);
+        ProptestConfig {
+            cases,
+            ..ProptestConfig::default()
+        }
+    }
+
+    /// Words a damaged list could hold: numbers of every kind, names, comments.
+    fn word() -> impl Strategy<Value = String> {
+        prop_oneof![
+            any::<f64>().prop_map(|x| x.to_string()),
+            (0u32..100).prop_map(|x| format!("{}.{x:02}", x / 10)),
+            prop::sample::select(vec![
+                "nan",
+                "NaN",
+                "inf",
+                "-inf",
+                "1e400",
+                "-0",
+                "0",
+                "1",
+                "0.0",
+                "#",
+                "rgb/1.png",
+                "..",
+                "/dev/zero",
+                "",
+                "1.0.0",
+                "+",
+                "e5",
+            ])
+            .prop_map(str::to_owned),
+            "\\PC{0,6}",
+        ]
+    }
+
+    fn list_text() -> impl Strategy<Value = String> {
+        let line = vec(word(), 0..10).prop_map(|words| words.join(" "));
+        vec(line, 0..24).prop_map(|lines| lines.join("\n"))
+    }
+
+    /// What every accepted row must satisfy.
+    fn check_rows(rows: &[Row], columns: usize) {
+        for pair in rows.windows(2) {
+            assert!(pair[0].timestamp_s < pair[1].timestamp_s, "{rows:?}");
+        }
+        for row in rows {
+            assert_eq!(row.values.len(), columns - 1);
+            assert!(row.timestamp_s.is_finite() && row.values.iter().all(|v| v.is_finite()));
+        }
+    }
+
+    fn check_all(text: &str) {
+        let path = Path::new("list.txt");
+        if let Ok(rows) = parse_rows(text, path, 4) {
+            check_rows(&rows, 4);
+        }
+        if let Ok(poses) = parse_poses(text, path) {
+            for pose in &poses {
+                let m = glam::DMat4::from(pose.world_from_camera);
+                assert!(m.is_finite(), "{m}");
+                let det = pose.world_from_camera.matrix3.determinant();
+                assert!((det - 1.0).abs() < 1e-9, "rotation determinant {det}");
+            }
+        }
+        if let Ok(files) = parse_file_list(text, Path::new("root"), path) {
+            for pair in files.windows(2) {
+                assert!(pair[0].timestamp_s < pair[1].timestamp_s);
+            }
+        }
+    }
+
+    proptest! {
+        #![proptest_config(config())]
+
+        #[test]
+        fn list_readers_never_panic_on_arbitrary_bytes(bytes in vec(any::<u8>(), 0..600)) {
+            check_all(&String::from_utf8_lossy(&bytes));
+        }
+
+        #[test]
+        fn list_readers_never_panic_and_keep_their_invariants_on_number_like_lines(
+            text in list_text()
+        ) {
+            check_all(&text);
+        }
+    }
+
+    #[test]
+    fn a_repeated_timestamp_is_an_error_naming_the_file_and_line() {
+        let text = "# t x y z\n1.0 0 0 9.8\n1.5 0 0 9.8\n1.5 0 0 9.8\n";
+        let err = parse_rows(text, Path::new("accelerometer.txt"), 4).expect_err("a repeat");
+        let message = err.to_string();
+        assert!(
+            message.contains("accelerometer.txt, line 4") && message.contains("repeats"),
+            "{message}"
+        );
+        let err = parse_file_list("2 a.png\n1 b.png\n", Path::new("."), Path::new("rgb.txt"))
+            .expect_err("going back");
+        assert!(err.to_string().contains("rgb.txt, line 2"), "{err}");
+    }
+
+    #[test]
+    fn zero_and_non_unit_quaternions_are_errors_naming_the_line() {
+        let path = Path::new("groundtruth.txt");
+        let good = "1.0 0 0 0 0 0 0 1\n";
+        assert_eq!(parse_poses(good, path).expect("a unit quaternion").len(), 1);
+        for bad in [
+            "2.0 0 0 0 0 0 0 0",
+            "2.0 0 0 0 0.2 0 0 0.2",
+            "2.0 0 0 0 0 0 0 nan",
+        ] {
+            let err = parse_poses(&format!("{good}{bad}\n"), path).expect_err(bad);
+            assert!(err.to_string().contains("line 2"), "{bad}: {err}");
+        }
+    }
+
+    #[test]
+    fn a_frame_that_is_not_a_regular_file_is_skipped_naming_it() {
+        let camera = Camera::pinhole(4, 4, 4.0, 4.0, 2.0, 2.0);
+        let reason = decode_gray(Path::new("/dev/zero"), &camera).expect_err("a device");
+        assert!(reason.contains("not a regular file"), "{reason}");
+    }
 }

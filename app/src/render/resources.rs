@@ -200,13 +200,35 @@ impl Renderer {
         self.points = upload(&gpu.device, &positions, None);
     }
 
-    /// Uploads a camera image (tightly packed RGBA8, sRGB) taken with `intrinsics`.
+    /// Uploads a camera image (tightly packed RGBA8, sRGB) taken with `intrinsics`. An image
+    /// with a side over the device's texture limit is scaled down to fit (the shader samples it
+    /// in normalised coordinates, so the intrinsics stay those of the full image); one whose
+    /// byte count does not match its intrinsics is not shown.
     pub fn set_camera_image(&mut self, gpu: &Gpu, rgba: &[u8], intrinsics: Intrinsics) {
-        let size = (intrinsics.width, intrinsics.height);
-        if rgba.len() != (size.0 * size.1 * 4) as usize {
+        let full = (intrinsics.width, intrinsics.height);
+        let expected_len = u64::from(full.0) * u64::from(full.1) * 4;
+        if full.0 == 0 || full.1 == 0 || rgba.len() as u64 != expected_len {
             self.has_camera_image = false;
             return;
         }
+        let max_side = gpu.device.limits().max_texture_dimension_2d;
+        let size = fit_within(full, max_side);
+        let scaled;
+        let rgba = if size == full {
+            rgba
+        } else {
+            let Some(image) = image::RgbaImage::from_raw(full.0, full.1, rgba.to_vec()) else {
+                self.has_camera_image = false;
+                return;
+            };
+            scaled = image::imageops::resize(
+                &image,
+                size.0,
+                size.1,
+                image::imageops::FilterType::Triangle,
+            );
+            scaled.as_raw().as_slice()
+        };
         let current = self.background.texture.size();
         if (current.width, current.height) != size {
             self.background.texture = background_texture(&gpu.device, size);
@@ -455,6 +477,18 @@ fn orthographic(half: f32, near: f32, far: f32) -> Mat4 {
     )
 }
 
+/// `size` scaled down (aspect kept, each side at least 1) so that neither side exceeds
+/// `max_side`; unchanged when it fits.
+pub fn fit_within(size: (u32, u32), max_side: u32) -> (u32, u32) {
+    let longest = size.0.max(size.1);
+    if longest <= max_side || max_side == 0 {
+        return size;
+    }
+    let scale = f64::from(max_side) / f64::from(longest);
+    let side = |s: u32| ((f64::from(s) * scale).round() as u32).clamp(1, max_side);
+    (side(size.0), side(size.1))
+}
+
 /// The largest region of the target with the camera image's aspect, centred: x, y, w, h.
 pub fn letterbox(size: (u32, u32), k: &Intrinsics) -> [f32; 4] {
     let (tw, th) = (size.0 as f32, size.1 as f32);
@@ -572,6 +606,14 @@ mod tests {
         let k = Intrinsics::from_fov(640, 480, 1.0);
         assert_eq!(letterbox((640, 480), &k), [0.0, 0.0, 640.0, 480.0]);
         assert_eq!(letterbox((1000, 480), &k), [180.0, 0.0, 640.0, 480.0]);
+    }
+
+    #[test]
+    fn an_image_over_the_texture_limit_is_scaled_to_fit_keeping_its_aspect() {
+        assert_eq!(fit_within((640, 480), 16384), (640, 480));
+        assert_eq!(fit_within((17000, 1000), 16384), (16384, 964));
+        assert_eq!(fit_within((3000, 40000), 8192), (614, 8192));
+        assert_eq!(fit_within((u32::MAX, 1), 4096), (4096, 1));
     }
 
     #[test]
