@@ -13,7 +13,8 @@ use glam::camera::rh::view::look_at_mat4;
 use glam::{Mat4, Vec2, Vec3, Vec4Swizzles};
 use image::{Rgba, RgbaImage};
 use sylva_core::Tree;
-use sylva_core::geometry::textures::{bark_texture, leaf_texture};
+use sylva_core::geometry::leaf_card::card_texture;
+use sylva_core::geometry::textures::bark_texture;
 use sylva_core::geometry::{TreeMesh, build_tree_meshes};
 use sylva_core::species::Species;
 
@@ -210,7 +211,7 @@ fn render(
     draw_ground(&mut target, tree, ground_radius, clip_from_world);
     let lod = &meshes.lods[0];
     let bark = bark_texture(meshes.colors.bark, 128);
-    let leaf = leaf_texture(meshes.colors.leaf, 128);
+    let leaf = card_texture(&meshes, 256);
     let fruit = RgbaImage::from_pixel(
         1,
         1,

@@ -7,7 +7,8 @@ use gltf_json as json;
 use json::validation::{Checked::Valid, USize64};
 
 use super::{ExportError, TEXTURE_SIZE, ambient_color};
-use crate::geometry::textures::{bark_texture, leaf_texture, png_bytes};
+use crate::geometry::leaf_card::card_texture;
+use crate::geometry::textures::{bark_texture, png_bytes};
 use crate::geometry::{TreeMesh, TreeMeshes};
 
 const GLB_MAGIC: u32 = 0x4654_6C67; // "glTF"
@@ -279,10 +280,7 @@ fn build(meshes: &TreeMeshes, path: &Path) -> Result<Vec<u8>, ExportError> {
     let leaf = if meshes.leaves.is_empty() {
         None
     } else {
-        let leaf_png = builder.png(
-            "leaf texture",
-            &leaf_texture(meshes.colors.leaf, TEXTURE_SIZE),
-        )?;
+        let leaf_png = builder.png("leaf texture", &card_texture(meshes, TEXTURE_SIZE))?;
         let texture = builder.texture("leaf", &leaf_png, json::texture::WrappingMode::ClampToEdge);
         let views = builder.vertex_views(&meshes.leaves);
         Some((

@@ -7,8 +7,12 @@
 //!   C.3, [`topology`]) and the first ring of every lateral branch is laid onto its parent's
 //!   surface, so dominant laterals leave no cracks. Sides per branch C = 3·dⁿ/d_e (eq. C.2).
 //!   Bark UVs are tiled along the path with a small rotation per segment; normals are smooth.
-//! - **Leaves** ([`leaves`]) are alpha-textured quads on branches thinner than a threshold,
-//!   oriented by the petiole model of appendix C.1.2; sunlit leaves turn their blade to the light.
+//! - **Leaves** ([`leaves`]) are alpha-textured cards on branches thinner than a threshold, at a
+//!   density per metre of twig of their own (appendix C.1.1), oriented by the petiole model of
+//!   appendix C.1.2; sunlit leaves turn their blade to the light. A card holds a spray of
+//!   several leaves where they are small ([`leaf_card`]), so density costs cards, not quads.
+//!   No leaf reaches below the ground plane through the tree's base.
+//! - **Crown measures** ([`crown`]): leaf area index and porosity, by rasterising the meshes.
 //! - **Fruit** grows on buds with p = r·L² above a threshold (appendix C.2).
 //! - **Ambient**: every vertex carries the ambient light of the growth shadow grid, sampled
 //!   through a callback so this module does not depend on growth.
@@ -24,7 +28,9 @@
 //! to be cast to GPU buffers.
 
 mod branches;
+pub mod crown;
 mod lanes;
+pub mod leaf_card;
 pub mod leaves;
 mod looks;
 mod mesher;
@@ -40,6 +46,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::tree::{NodeId, Skeleton};
 
+pub use leaf_card::LeafCard;
 pub use leaves::{FruitParams, LeafParams};
 pub use looks::{build_tree_level, build_tree_meshes, build_tree_meshes_with, mesh_params_for};
 pub use mesher::{Levels, Mesher};
@@ -254,8 +261,10 @@ pub struct MaterialColors {
 pub struct TreeMeshes {
     /// The levels built, finest first: all of them, or the one asked for ([`Levels`]).
     pub lods: Vec<Lod>,
-    /// Quads of 4 vertices and 6 indices each, in random order.
+    /// Leaf cards ([`LeafCard`]): quads of 4 vertices and 6 indices each, in random order.
     pub leaves: TreeMesh,
+    /// The layout of the leaves on each card of [`Self::leaves`].
+    pub leaf_card: LeafCard,
     /// Fruit meshes in random order.
     pub fruit: TreeMesh,
     pub colors: MaterialColors,
