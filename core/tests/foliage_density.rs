@@ -2,6 +2,8 @@
 //! blade area over the crown's projection on the ground) and the side view's crown porosity,
 //! measured by rasterising the meshes; leaves and fruit never below the ground plane.
 
+mod support;
+
 use std::sync::OnceLock;
 
 use sylva_core::Tree;
@@ -106,10 +108,7 @@ fn no_leaf_or_fruit_of_a_40_year_weeping_willow_or_oak_is_below_the_ground() {
         let ground_y = tree.ground_y();
         let meshes = build_tree_meshes(&tree);
         for (part, mesh) in [("leaves", &meshes.leaves), ("fruit", &meshes.fruit)] {
-            let lowest = mesh
-                .positions
-                .iter()
-                .fold(f32::INFINITY, |y, p| y.min(p[1]));
+            let lowest = support::lowest_y(mesh);
             assert!(
                 lowest >= ground_y - 1e-4,
                 "{name}'s {part} reach {:.3} m below the ground",

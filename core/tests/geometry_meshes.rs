@@ -283,10 +283,7 @@ fn leaves_of_a_branch_hanging_to_the_lawn_rest_on_it_and_never_sink_below() {
         let meshes = build_meshes(&skeleton, &params, &|_| 1.0);
         assert!(!meshes.leaves.is_empty() && !meshes.fruit.is_empty());
         for (part, mesh) in [("leaves", &meshes.leaves), ("fruit", &meshes.fruit)] {
-            let lowest = mesh
-                .positions
-                .iter()
-                .fold(f32::INFINITY, |y, p| y.min(p[1]));
+            let lowest = support::lowest_y(mesh);
             assert!(
                 lowest >= ground_y - 1e-5,
                 "{leaves_per_card} leaves per card: {part} reach {:.3} m below the ground",

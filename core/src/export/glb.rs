@@ -8,7 +8,7 @@ use json::validation::{Checked::Valid, USize64};
 
 use super::{ExportError, TEXTURE_SIZE, ambient_color};
 use crate::geometry::leaf_card::card_texture;
-use crate::geometry::textures::{bark_texture, png_bytes};
+use crate::geometry::textures::bark_texture;
 use crate::geometry::{TreeMesh, TreeMeshes};
 
 const GLB_MAGIC: u32 = 0x4654_6C67; // "glTF"
@@ -30,7 +30,7 @@ pub fn glb_bytes(meshes: &TreeMeshes) -> Result<Vec<u8>, ExportError> {
 struct VertexViews {
     positions: json::Index<json::buffer::View>,
     normals: json::Index<json::buffer::View>,
-    uvs: json::Index<json::buffer::View>,
+    uvs: Option<json::Index<json::buffer::View>>,
     colors: json::Index<json::buffer::View>,
     indices: json::Index<json::buffer::View>,
 }
@@ -93,7 +93,9 @@ impl<'a> Builder<'a> {
         })
     }
 
-    fn vertex_views(&mut self, mesh: &TreeMesh) -> VertexViews {
+    /// The buffer views of `mesh`'s attributes; texture coordinates only `with_uvs` (a part
+    /// drawn without a texture gets none, which readers would carry unused).
+    fn vertex_views(&mut self, mesh: &TreeMesh, with_uvs: bool) -> VertexViews {
         use json::buffer::Target::{ArrayBuffer, ElementArrayBuffer};
         let positions = self.view(
             &f32_bytes(mesh.positions.iter().flatten()),
@@ -105,11 +107,13 @@ impl<'a> Builder<'a> {
             Some(ArrayBuffer),
             Some(12),
         );
-        let uvs = self.view(
-            &f32_bytes(mesh.uvs.iter().flatten()),
-            Some(ArrayBuffer),
-            Some(8),
-        );
+        let uvs = with_uvs.then(|| {
+            self.view(
+                &f32_bytes(mesh.uvs.iter().flatten()),
+                Some(ArrayBuffer),
+                Some(8),
+            )
+        });
         let colors: Vec<u8> = mesh
             .ambient
             .iter()
@@ -162,8 +166,10 @@ impl<'a> Builder<'a> {
         attributes.insert(Valid(json::mesh::Semantic::Positions), position);
         let normal = self.accessor(views.normals, num_vertices, F32, Vec3, false, None);
         attributes.insert(Valid(json::mesh::Semantic::Normals), normal);
-        let uv = self.accessor(views.uvs, num_vertices, F32, Vec2, false, None);
-        attributes.insert(Valid(json::mesh::Semantic::TexCoords(0)), uv);
+        if let Some(uvs) = views.uvs {
+            let uv = self.accessor(uvs, num_vertices, F32, Vec2, false, None);
+            attributes.insert(Valid(json::mesh::Semantic::TexCoords(0)), uv);
+        }
         let color = self.accessor(views.colors, num_vertices, U8, Vec4, true, None);
         attributes.insert(Valid(json::mesh::Semantic::Colors(0)), color);
         let indices = self.accessor(views.indices, num_indices, U32, Scalar, false, None);
@@ -246,7 +252,7 @@ impl<'a> Builder<'a> {
     }
 
     fn png(&self, what: &'static str, image: &image::RgbaImage) -> Result<Vec<u8>, ExportError> {
-        png_bytes(image).map_err(|e| ExportError::Encode {
+        super::texture_png(image).map_err(|e| ExportError::Encode {
             path: self.path.to_path_buf(),
             what,
             reason: e.to_string(),
@@ -282,7 +288,7 @@ fn build(meshes: &TreeMeshes, path: &Path) -> Result<Vec<u8>, ExportError> {
     } else {
         let leaf_png = builder.png("leaf texture", &card_texture(meshes, TEXTURE_SIZE))?;
         let texture = builder.texture("leaf", &leaf_png, json::texture::WrappingMode::ClampToEdge);
-        let views = builder.vertex_views(&meshes.leaves);
+        let views = builder.vertex_views(&meshes.leaves, true);
         Some((
             builder.material("leaf", Some(texture), [1.0; 4], 0.6, true),
             views,
@@ -291,7 +297,7 @@ fn build(meshes: &TreeMeshes, path: &Path) -> Result<Vec<u8>, ExportError> {
     let fruit = if meshes.fruit.is_empty() {
         None
     } else {
-        let views = builder.vertex_views(&meshes.fruit);
+        let views = builder.vertex_views(&meshes.fruit, false);
         Some((
             builder.material("fruit", None, opaque(meshes.colors.fruit), 0.45, false),
             views,
@@ -300,7 +306,7 @@ fn build(meshes: &TreeMeshes, path: &Path) -> Result<Vec<u8>, ExportError> {
     for (level, lod) in meshes.lods.iter().enumerate() {
         let mut primitives = Vec::new();
         if !lod.branches.is_empty() {
-            let views = builder.vertex_views(&lod.branches);
+            let views = builder.vertex_views(&lod.branches, true);
             primitives.push(builder.primitive(
                 &lod.branches,
                 &views,

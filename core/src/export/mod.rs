@@ -55,3 +55,18 @@ impl ExportError {
 pub(crate) fn ambient_color(ambient: f32) -> f32 {
     0.3 + 0.7 * ambient.clamp(0.0, 1.0)
 }
+
+/// PNG bytes of a texture. One with no transparency (bark) is written RGB: an alpha channel it
+/// does not use would only make readers blend it.
+pub(crate) fn texture_png(image: &image::RgbaImage) -> Result<Vec<u8>, image::ImageError> {
+    let mut bytes = Vec::new();
+    let mut cursor = std::io::Cursor::new(&mut bytes);
+    if image.pixels().all(|p| p[3] == 255) {
+        image::DynamicImage::ImageRgba8(image.clone())
+            .to_rgb8()
+            .write_to(&mut cursor, image::ImageFormat::Png)?;
+    } else {
+        image.write_to(&mut cursor, image::ImageFormat::Png)?;
+    }
+    Ok(bytes)
+}

@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 
 use super::{ExportError, TEXTURE_SIZE};
 use crate::geometry::leaf_card::card_texture;
-use crate::geometry::textures::{bark_texture, png_bytes};
+use crate::geometry::textures::bark_texture;
 use crate::geometry::{TreeMesh, TreeMeshes};
 
 /// Writes the finest level of `meshes` to `path` (OBJ), `path` with extension `.mtl`, and the
@@ -88,7 +88,7 @@ pub fn write_obj(meshes: &TreeMeshes, path: &Path) -> Result<(), ExportError> {
 }
 
 fn write_png(path: &Path, image: &image::RgbaImage, what: &'static str) -> Result<(), ExportError> {
-    let bytes = png_bytes(image).map_err(|e| ExportError::Encode {
+    let bytes = super::texture_png(image).map_err(|e| ExportError::Encode {
         path: path.to_path_buf(),
         what,
         reason: e.to_string(),

@@ -83,7 +83,14 @@ pub fn assert_reimport_matches(path: &Path, meshes: &TreeMeshes) {
                 triangles += reader.read_indices().expect("indexed").into_u32().count() / 3;
                 let positions: Vec<[f32; 3]> =
                     reader.read_positions().expect("positions").collect();
-                assert!(reader.read_normals().is_some() && reader.read_tex_coords(0).is_some());
+                assert!(reader.read_normals().is_some());
+                // Only textured parts carry texture coordinates (the fruit has none).
+                let textured = primitive
+                    .material()
+                    .pbr_metallic_roughness()
+                    .base_color_texture()
+                    .is_some();
+                assert_eq!(reader.read_tex_coords(0).is_some(), textured);
                 for p in positions {
                     lo = lo.min(p.into());
                     hi = hi.max(p.into());
@@ -189,4 +196,11 @@ pub fn mean_rise(tree: &sylva_core::Tree, orders: std::ops::RangeInclusive<u32>)
         .map(|n| n.heading().y)
         .collect();
     rises.iter().sum::<f32>() / rises.len().max(1) as f32
+}
+
+/// The lowest height of any vertex of `mesh` (+∞ for an empty mesh).
+pub fn lowest_y(mesh: &sylva_core::geometry::TreeMesh) -> f32 {
+    mesh.positions
+        .iter()
+        .fold(f32::INFINITY, |y, p| y.min(p[1]))
 }
