@@ -11,6 +11,9 @@ use crate::geometry::leaf_card::card_texture;
 use crate::geometry::textures::bark_texture;
 use crate::geometry::{TreeMesh, TreeMeshes};
 
+/// The glTF extension naming a node's coarser levels of detail.
+const MSFT_LOD: &str = "MSFT_lod";
+
 const GLB_MAGIC: u32 = 0x4654_6C67; // "glTF"
 const CHUNK_JSON: u32 = 0x4E4F_534A;
 const CHUNK_BIN: u32 = 0x004E_4942;
@@ -303,6 +306,7 @@ fn build(meshes: &TreeMeshes, path: &Path) -> Result<Vec<u8>, ExportError> {
             views,
         ))
     };
+    let mut level_nodes = Vec::new();
     for (level, lod) in meshes.lods.iter().enumerate() {
         let mut primitives = Vec::new();
         if !lod.branches.is_empty() {
@@ -341,16 +345,31 @@ fn build(meshes: &TreeMeshes, path: &Path) -> Result<Vec<u8>, ExportError> {
             primitives,
             weights: None,
         });
-        let node = builder.root.push(json::Node {
+        level_nodes.push(builder.root.push(json::Node {
             mesh: Some(mesh),
             name: Some(format!("tree_{name}")),
             ..Default::default()
-        });
+        }));
+    }
+    // One scene with one tree: the finest level is a plain mesh node, which readers without
+    // MSFT_lod draw; its MSFT_lod extension lists the coarser levels' nodes, finest first.
+    // The extension is used, not required.
+    if let Some((&finest, coarser)) = level_nodes.split_first() {
+        if !coarser.is_empty() {
+            let ids: Vec<serde_json::Value> = coarser.iter().map(|n| n.value().into()).collect();
+            let mut others = serde_json::Map::new();
+            others.insert(MSFT_LOD.into(), serde_json::json!({ "ids": ids }));
+            builder.root.nodes[finest.value()].extensions = Some(json::extensions::scene::Node {
+                others,
+                ..Default::default()
+            });
+            builder.root.extensions_used.push(MSFT_LOD.into());
+        }
         builder.root.push(json::Scene {
             extensions: None,
             extras: Default::default(),
-            name: Some(name),
-            nodes: vec![node],
+            name: Some("tree".into()),
+            nodes: vec![finest],
         });
     }
     builder.root.scene = Some(json::Index::new(0));
