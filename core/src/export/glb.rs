@@ -359,9 +359,8 @@ fn build(meshes: &TreeMeshes, path: &Path) -> Result<Vec<u8>, ExportError> {
             let ids: Vec<serde_json::Value> = coarser.iter().map(|n| n.value().into()).collect();
             let mut others = serde_json::Map::new();
             others.insert(MSFT_LOD.into(), serde_json::json!({ "ids": ids }));
-            let mut extensions = json::extensions::scene::Node::default();
-            extensions.others = others;
-            builder.root.nodes[finest.value()].extensions = Some(extensions);
+            builder.root.nodes[finest.value()].extensions =
+                Some(json::extensions::scene::Node { others });
             builder.root.extensions_used.push(MSFT_LOD.into());
         }
         builder.root.push(json::Scene {
