@@ -166,6 +166,7 @@ impl Digest {
             }
             d.len(lod.num_leaf_indices);
             d.len(lod.num_fruit_indices);
+            d.mesh(&lod.merged_leaves);
         }
         d.mesh(&meshes.leaves);
         d.mesh(&meshes.fruit);

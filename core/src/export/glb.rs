@@ -30,6 +30,7 @@ pub fn glb_bytes(meshes: &TreeMeshes) -> Result<Vec<u8>, ExportError> {
 }
 
 /// Accessors of one vertex buffer (views shared by every level that draws a prefix of it).
+#[derive(Clone, Copy)]
 struct VertexViews {
     positions: json::Index<json::buffer::View>,
     normals: json::Index<json::buffer::View>,
@@ -319,12 +320,15 @@ fn build(meshes: &TreeMeshes, path: &Path) -> Result<Vec<u8>, ExportError> {
             ));
         }
         if let Some((material, views)) = leaf.as_ref().filter(|_| lod.num_leaf_indices > 0) {
-            primitives.push(builder.primitive(
-                &meshes.leaves,
-                views,
-                lod.num_leaf_indices,
-                *material,
-            ));
+            let cards = lod.leaves_in(&meshes.leaves);
+            // The finest level's cards are shared views; a coarse level's merged cards get
+            // their own.
+            let views = if lod.level == 0 {
+                *views
+            } else {
+                builder.vertex_views(cards, true)
+            };
+            primitives.push(builder.primitive(cards, &views, lod.num_leaf_indices, *material));
         }
         if let Some((material, views)) = fruit.as_ref().filter(|_| lod.num_fruit_indices > 0) {
             primitives.push(builder.primitive(

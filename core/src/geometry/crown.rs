@@ -118,7 +118,7 @@ pub fn crown_measures(
     if num_leaf_indices == 0 {
         return None;
     }
-    let card_area_m2 = leaf_card_area_m2(&meshes.leaves, num_leaf_indices);
+    let card_area_m2 = leaf_card_area_m2(level.leaves_in(&meshes.leaves), num_leaf_indices);
     let leaf_area_m2 = card_area_m2 * leaf_mask.opaque_fraction();
     let top = rasterise(meshes, lod, leaf_mask, View::Top, pixel_size_m)?;
     let side = rasterise(meshes, lod, leaf_mask, View::Side, pixel_size_m)?;
@@ -160,7 +160,8 @@ pub fn leaf_card_area_m2(leaves: &TreeMesh, num_indices: usize) -> f32 {
     area
 }
 
-/// The coverage of level `lod` of `meshes` in `view`; `None` for an empty level.
+/// The coverage of level `lod` of `meshes` in `view`, over the level's bounds; `None` for an
+/// empty level.
 pub fn rasterise(
     meshes: &TreeMeshes,
     lod: usize,
@@ -168,8 +169,36 @@ pub fn rasterise(
     view: View,
     pixel_size_m: f32,
 ) -> Option<Coverage> {
-    let (lo, hi) = meshes.bounds(lod)?;
-    let level = &meshes.lods[lod];
+    let bounds = meshes.bounds(lod)?;
+    Some(rasterise_within(
+        meshes,
+        lod,
+        leaf_mask,
+        view,
+        pixel_size_m,
+        bounds,
+    ))
+}
+
+/// [`rasterise`] onto the pixels covering `bounds` (world min, max), so that two levels of
+/// detail rasterised within the same bounds can be compared pixel by pixel
+/// ([`Coverage::num_differing`]).
+pub fn rasterise_within(
+    meshes: &TreeMeshes,
+    lod: usize,
+    leaf_mask: &AlphaMask,
+    view: View,
+    pixel_size_m: f32,
+    (lo, hi): (Vec3, Vec3),
+) -> Coverage {
+    let Some(level) = meshes.lods.get(lod) else {
+        return Coverage {
+            width: 0,
+            height: 0,
+            pixel_size_m,
+            pixels: Vec::new(),
+        };
+    };
     let (a, b) = (view.project(lo), view.project(hi));
     let origin = a.min(b);
     let extent = a.max(b) - origin;
@@ -186,7 +215,12 @@ pub fn rasterise(
     let solid = AlphaMask::solid();
     let parts: [(&TreeMesh, usize, u8, &AlphaMask); 3] = [
         (&level.branches, level.branches.indices.len(), WOOD, &solid),
-        (&meshes.leaves, level.num_leaf_indices, LEAF, leaf_mask),
+        (
+            level.leaves_in(&meshes.leaves),
+            level.num_leaf_indices,
+            LEAF,
+            leaf_mask,
+        ),
         (&meshes.fruit, level.num_fruit_indices, WOOD, &solid),
     ];
     for (mesh, num_indices, flag, mask) in parts {
@@ -198,7 +232,7 @@ pub fn rasterise(
             coverage.fill([corner(0), corner(1), corner(2)], mask, flag);
         }
     }
-    Some(coverage)
+    coverage
 }
 
 impl Coverage {
@@ -305,6 +339,35 @@ impl Coverage {
             .filter(|&(&a, &b)| (a & flags != 0) != (b & flags != 0))
             .count();
         Some(n)
+    }
+}
+
+impl Coverage {
+    /// How far the image of `other` departs from this one's when both are seen at `block` ×
+    /// `block` pixels per screen pixel, as a renderer filters them at a distance: the sum over
+    /// screen pixels of |Δ opacity| (opacity = covered fraction of the block) over the sum of
+    /// this image's opacity. `None` for coverages of different sizes.
+    pub fn filtered_difference(&self, other: &Coverage, flags: u8, block: usize) -> Option<f32> {
+        if (self.width, self.height) != (other.width, other.height) {
+            return None;
+        }
+        let block = block.max(1);
+        let (mut differing, mut total) = (0u64, 0u64);
+        for by in (0..self.height).step_by(block) {
+            for bx in (0..self.width).step_by(block) {
+                let (mut a, mut b) = (0i64, 0i64);
+                for y in by..(by + block).min(self.height) {
+                    for x in bx..(bx + block).min(self.width) {
+                        let i = y * self.width + x;
+                        a += i64::from(self.pixels[i] & flags != 0);
+                        b += i64::from(other.pixels[i] & flags != 0);
+                    }
+                }
+                differing += (a - b).unsigned_abs();
+                total += a as u64;
+            }
+        }
+        Some(differing as f32 / total.max(1) as f32)
     }
 }
 

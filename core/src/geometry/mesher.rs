@@ -93,8 +93,19 @@ impl Mesher {
         meshes.lods.resize_with(levels.len(), Lod::default);
         for (lod, level) in meshes.lods.iter_mut().zip(levels) {
             self.mesh_level(level, lod);
-            lod.num_leaf_indices =
-                prefix_indices(meshes.leaves.indices.len(), 6, lod.target_fraction);
+            let num_cards = prefix_indices(meshes.leaves.indices.len(), 6, lod.target_fraction);
+            if level == 0 {
+                lod.merged_leaves.clear();
+            } else {
+                leaves::merge_cards_into(
+                    &meshes.leaves,
+                    num_cards / 6,
+                    lod.target_fraction,
+                    ground_y,
+                    &mut lod.merged_leaves,
+                );
+            }
+            lod.num_leaf_indices = num_cards;
             lod.num_fruit_indices =
                 prefix_indices(meshes.fruit.indices.len(), 3, lod.target_fraction);
         }

@@ -17,7 +17,9 @@
 //! - **Ambient**: every vertex carries the ambient light of the growth shadow grid, sampled
 //!   through a callback so this module does not depend on growth.
 //! - **Levels of detail** ([`Lod`]): about 100%, 40% and 15% of the triangles, by fewer sides,
-//!   dropping the thinnest branches and drawing a prefix of the randomly ordered leaf buffer.
+//!   dropping the thinnest branches, and merging leaf cards: a coarse level keeps a fraction f
+//!   of the randomly ordered cards, each scaled by 1/√f about its base, so the leaf area and
+//!   the crown's silhouette stay while the cards thin out.
 //!
 //! Building: [`build_meshes`] makes every level (export, LOD switching); [`build_level`] makes
 //! only the level a renderer draws, plus the whole leaf and fruit buffers; a [`Mesher`] kept
@@ -235,13 +237,28 @@ pub struct Lod {
     pub target_fraction: f32,
     pub branches: TreeMesh,
     pub branch_starts: Vec<BranchStart>,
-    /// This level draws the first `num_leaf_indices` of [`TreeMeshes::leaves`].
+    /// This level draws the first `num_leaf_indices` of [`Lod::leaves_in`]: of
+    /// [`TreeMeshes::leaves`] at the finest level, of [`Lod::merged_leaves`] at coarser ones.
     pub num_leaf_indices: usize,
+    /// A coarse level's leaf cards: fewer cards, each larger, holding the leaf area of the
+    /// cards it stands for, so the crown keeps its silhouette instead of going bald. Empty at
+    /// the finest level.
+    pub merged_leaves: TreeMesh,
     /// This level draws the first `num_fruit_indices` of [`TreeMeshes::fruit`].
     pub num_fruit_indices: usize,
 }
 
 impl Lod {
+    /// The leaf cards this level draws a prefix of: its merged cards, or `finest` (the tree's
+    /// [`TreeMeshes::leaves`]) at the finest level.
+    pub fn leaves_in<'a>(&'a self, finest: &'a TreeMesh) -> &'a TreeMesh {
+        if self.level == 0 {
+            finest
+        } else {
+            &self.merged_leaves
+        }
+    }
+
     pub fn num_triangles(&self) -> usize {
         self.branches.num_triangles() + (self.num_leaf_indices + self.num_fruit_indices) / 3
     }
@@ -281,7 +298,9 @@ impl TreeMeshes {
         let level = self.lods.get(lod)?;
         [
             level.branches.bounds(),
-            self.leaves.bounds_of_prefix(level.num_leaf_indices),
+            level
+                .leaves_in(&self.leaves)
+                .bounds_of_prefix(level.num_leaf_indices),
             self.fruit.bounds_of_prefix(level.num_fruit_indices),
         ]
         .into_iter()
