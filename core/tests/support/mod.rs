@@ -231,3 +231,28 @@ pub fn lowest_y(mesh: &sylva_core::geometry::TreeMesh) -> f32 {
         .iter()
         .fold(f32::INFINITY, |y, p| y.min(p[1]))
 }
+
+/// What glTF Transform (`node tools/gltf-reader/read.mjs`, a real reader) finds in `path`: its
+/// JSON report. Panics, loudly, when node or the package is missing: the check must never be
+/// skipped silently.
+pub fn read_glb_with_gltf_transform(path: &Path) -> serde_json::Value {
+    let script = workspace_root().join("tools/gltf-reader/read.mjs");
+    let package = workspace_root().join("tools/gltf-reader/node_modules/@gltf-transform/core");
+    assert!(
+        package.is_dir(),
+        "glTF Transform is not installed: run `bash scripts/setup.sh` (npm install in \
+         tools/gltf-reader)"
+    );
+    let output = Command::new("node")
+        .arg(&script)
+        .arg(path)
+        .output()
+        .expect("node runs (install nodejs)");
+    assert!(
+        output.status.success(),
+        "glTF Transform failed on {}: {}",
+        path.display(),
+        String::from_utf8_lossy(&output.stderr)
+    );
+    serde_json::from_slice(&output.stdout).expect("the reader prints JSON")
+}
