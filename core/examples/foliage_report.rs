@@ -1,10 +1,11 @@
 //! Foliage of every species preset: leaf area index (one-sided blade area over the crown's
-//! projection on the ground), the side view's crown porosity, and the triangles at LOD0, at
-//! 15, 30 and 40 years. Measured by rasterising the meshes (`geometry::crown`).
+//! projection on the ground), the side view's crown porosity, the triangles at LOD0 and the
+//! size of the `.glb`, at 15, 30 and 40 years. Measured by rasterising the meshes (`geometry::crown`).
 //!
 //! `cargo run --release -p sylva-core --example foliage_report [seed]`
 
 use sylva_core::Tree;
+use sylva_core::export::glb_bytes;
 use sylva_core::geometry::build_tree_meshes;
 use sylva_core::geometry::crown::{AlphaMask, CARD_TEXTURE_SIZE, MEASURE_PIXEL_M, crown_measures};
 use sylva_core::geometry::leaf_card::card_texture;
@@ -18,7 +19,7 @@ fn main() {
         .and_then(|a| a.parse().ok())
         .unwrap_or(11);
     println!(
-        "{:<16} {:>5} {:>9} {:>7} {:>9} {:>8} {:>5} {:>9} {:>9} {:>9}",
+        "{:<16} {:>5} {:>9} {:>7} {:>9} {:>8} {:>5} {:>9} {:>9} {:>9} {:>7}",
         "preset",
         "years",
         "internodes",
@@ -28,7 +29,8 @@ fn main() {
         "LAI",
         "porosity",
         "leaf tris",
-        "LOD0 tris"
+        "LOD0 tris",
+        "glb MB"
     );
     for species in Species::presets() {
         let name = species.name.clone();
@@ -42,7 +44,7 @@ fn main() {
                 continue;
             };
             println!(
-                "{:<16} {:>5} {:>9} {:>7} {:>9.1} {:>8.1} {:>5.2} {:>8.1}% {:>9} {:>9}",
+                "{:<16} {:>5} {:>9} {:>7} {:>9.1} {:>8.1} {:>5.2} {:>8.1}% {:>9} {:>9} {:>7.1}",
                 name,
                 age,
                 tree.skeleton.len(),
@@ -53,6 +55,7 @@ fn main() {
                 100.0 * m.side_porosity,
                 meshes.lods[0].num_leaf_indices / 3,
                 meshes.num_triangles(0),
+                glb_bytes(&meshes).map_or(f64::NAN, |b| b.len() as f64 * 1e-6),
             );
         }
     }
