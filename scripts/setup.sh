@@ -37,5 +37,11 @@ if [ -f tools/gltf-validator/package.json ] && [ ! -d tools/gltf-validator/node_
   (cd tools/gltf-validator && npm install --no-audit --no-fund --silent >/dev/null)
 fi
 
+# A real glTF reader for the export tests: glTF Transform, pinned in tools/gltf-reader/package.json.
+if [ -f tools/gltf-reader/package.json ] && [ ! -d tools/gltf-reader/node_modules/@gltf-transform/core ]; then
+  echo "setup: installing @gltf-transform/core"
+  (cd tools/gltf-reader && npm install --no-audit --no-fund --silent >/dev/null)
+fi
+
 # Quiet Mesa, skip GL probing: lavapipe through Vulkan.
 mkdir -p /tmp/sylva-xdg && chmod 700 /tmp/sylva-xdg

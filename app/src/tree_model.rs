@@ -71,6 +71,8 @@ pub fn mesh_of(tree: &Tree) -> TreeMesh {
 pub struct TreeMesher {
     mesher: Mesher,
     meshes: TreeMeshes,
+    /// The leaf cards expanded into single leaves, which the leaf shader draws.
+    leaves: sylva_core::geometry::TreeMesh,
     mesh: TreeMesh,
 }
 
@@ -95,7 +97,11 @@ impl TreeMesher {
             Some(lod) => lit_into(&lod.branches, |uv| uv, &mut self.mesh.branches),
             None => self.mesh.branches = LitMesh::default(),
         }
-        lit_into(&self.meshes.leaves, leaf_uv, &mut self.mesh.leaves);
+        let cards = &self.meshes.leaves;
+        self.meshes
+            .leaf_card
+            .expand_into(cards, cards.indices.len(), &mut self.leaves);
+        lit_into(&self.leaves, leaf_uv, &mut self.mesh.leaves);
         self.mesh.bark_color = self.meshes.colors.bark;
         self.mesh.leaf_color = self.meshes.colors.leaf;
         &self.mesh
@@ -121,7 +127,14 @@ pub fn draw_mesh(meshes: &TreeMeshes) -> TreeMesh {
         .first()
         .map(|lod| lit(&lod.branches, |uv| uv))
         .unwrap_or_default();
-    let leaves = lit(&meshes.leaves, leaf_uv);
+    // The leaf shader draws one blade per quad: the cards expanded into their leaves.
+    let mut single_leaves = sylva_core::geometry::TreeMesh::default();
+    meshes.leaf_card.expand_into(
+        &meshes.leaves,
+        meshes.leaves.indices.len(),
+        &mut single_leaves,
+    );
+    let leaves = lit(&single_leaves, leaf_uv);
     TreeMesh {
         branches,
         leaves,

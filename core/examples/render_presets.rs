@@ -15,6 +15,7 @@ use glam::camera::rh::view::look_at_mat4;
 use glam::{Mat4, Vec2, Vec3, Vec4Swizzles};
 use image::{Rgba, RgbaImage};
 use sylva_core::Tree;
+use sylva_core::geometry::leaf_card::card_texture;
 use sylva_core::geometry::textures::{bark_texture, leaf_texture};
 use sylva_core::geometry::{Season, TreeMesh, build_tree_meshes_in};
 use sylva_core::species::Species;
@@ -218,7 +219,7 @@ fn render(
         128,
     ))
     .to_rgba8();
-    let leaf = leaf_texture(meshes.colors.leaf_shape, meshes.colors.leaf, 128);
+    let leaf = card_texture(&meshes, 256);
     let fruit = RgbaImage::from_pixel(
         1,
         1,

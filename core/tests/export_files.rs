@@ -44,6 +44,53 @@ fn reimporting_the_glb_gives_the_same_triangles_bounds_leaves_and_textures() {
 }
 
 #[test]
+fn only_textured_parts_carry_texture_coordinates_and_the_bark_texture_is_rgb() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("tree.glb");
+    let meshes = synthetic_meshes();
+    assert!(!meshes.fruit.is_empty(), "the synthetic tree bears fruit");
+    write_glb(&meshes, &path).expect("glb written");
+    let (document, _, images) = gltf::import(&path).expect("glb imports");
+    let mut materials_seen = Vec::new();
+    for mesh in document.meshes() {
+        for primitive in mesh.primitives() {
+            let material = primitive.material().name().unwrap_or("").to_string();
+            let has_uv = primitive.get(&gltf::Semantic::TexCoords(0)).is_some();
+            let textured = primitive
+                .material()
+                .pbr_metallic_roughness()
+                .base_color_texture()
+                .is_some();
+            assert_eq!(
+                has_uv, textured,
+                "{material}: TEXCOORD_0 {has_uv}, texture {textured}"
+            );
+            materials_seen.push(material);
+        }
+    }
+    assert!(
+        materials_seen.iter().any(|m| m == "fruit"),
+        "{materials_seen:?}"
+    );
+    let bark = document
+        .textures()
+        .find(|t| t.name() == Some("bark"))
+        .expect("a bark texture");
+    let format = images[bark.source().index()].format;
+    assert_eq!(format, gltf::image::Format::R8G8B8, "bark texture");
+    let leaf = document
+        .textures()
+        .find(|t| t.name() == Some("leaf"))
+        .expect("a leaf texture");
+    let format = images[leaf.source().index()].format;
+    assert_eq!(
+        format,
+        gltf::image::Format::R8G8B8A8,
+        "leaf texture keeps its alpha"
+    );
+}
+
+#[test]
 fn the_obj_holds_every_triangle_of_the_finest_level_and_its_materials() {
     let dir = tempfile::tempdir().expect("temp dir");
     let path = dir.path().join("tree.obj");

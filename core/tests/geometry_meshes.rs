@@ -234,3 +234,71 @@ fn meshing_is_deterministic_and_an_empty_skeleton_gives_empty_meshes() {
     assert_eq!(empty.num_triangles(0), 0);
     assert!(empty.bounds(0).is_none());
 }
+
+#[test]
+fn leaves_of_a_branch_hanging_to_the_lawn_rest_on_it_and_never_sink_below() {
+    // A trunk standing on y = 0.5 and a thin weeping branch whose tip reaches 2 cm above it:
+    // leaves hung from its last metre would reach below the ground plane through the base.
+    let ground_y = 0.5;
+    let mut nodes = vec![
+        node(
+            None,
+            Vec3::new(0.0, ground_y, 0.0),
+            Vec3::new(0.0, 2.5, 0.0),
+            0.2,
+        ),
+        node(
+            Some(0),
+            Vec3::new(0.0, 2.5, 0.0),
+            Vec3::new(0.8, 1.5, 0.0),
+            0.012,
+        ),
+        node(
+            Some(1),
+            Vec3::new(0.8, 1.5, 0.0),
+            Vec3::new(1.0, ground_y + 0.02, 0.0),
+            0.01,
+        ),
+    ];
+    nodes[0].lateral_children = Children::from_slice(&[NodeId(1)]);
+    nodes[1].main_child = Some(NodeId(2));
+    let skeleton = Skeleton { internodes: nodes };
+    skeleton.sanity_check().expect("valid hand-made skeleton");
+    for leaves_per_card in [1, 6] {
+        let params = MeshParams {
+            leaves: sylva_core::geometry::LeafParams {
+                leaves_per_metre: 200.0,
+                leaves_per_card,
+                length: 0.12,
+                width: 0.03,
+                ..Default::default()
+            },
+            fruit: Some(FruitParams {
+                threshold: 0.0,
+                radius: 0.05,
+                ..FruitParams::default()
+            }),
+            ..MeshParams::default()
+        };
+        let meshes = build_meshes(&skeleton, &params, &|_| 1.0);
+        assert!(!meshes.leaves.is_empty() && !meshes.fruit.is_empty());
+        for (part, mesh) in [("leaves", &meshes.leaves), ("fruit", &meshes.fruit)] {
+            let lowest = support::lowest_y(mesh);
+            assert!(
+                lowest >= ground_y - 1e-5,
+                "{leaves_per_card} leaves per card: {part} reach {:.3} m below the ground",
+                ground_y - lowest
+            );
+        }
+        let resting = meshes
+            .leaves
+            .positions
+            .iter()
+            .filter(|p| p[1] < ground_y + 1e-4)
+            .count();
+        assert!(
+            resting > 0,
+            "{leaves_per_card} leaves per card: no leaf reaches the lawn"
+        );
+    }
+}

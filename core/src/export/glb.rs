@@ -7,8 +7,12 @@ use gltf_json as json;
 use json::validation::{Checked::Valid, USize64};
 
 use super::{ExportError, TEXTURE_SIZE, ambient_color};
-use crate::geometry::textures::{bark_texture, leaf_texture, png_bytes};
+use crate::geometry::leaf_card::card_texture;
+use crate::geometry::textures::{bark_texture, png_bytes};
 use crate::geometry::{TreeMesh, TreeMeshes};
+
+/// The glTF extension naming a node's coarser levels of detail.
+const MSFT_LOD: &str = "MSFT_lod";
 
 const GLB_MAGIC: u32 = 0x4654_6C67; // "glTF"
 const CHUNK_JSON: u32 = 0x4E4F_534A;
@@ -26,10 +30,11 @@ pub fn glb_bytes(meshes: &TreeMeshes) -> Result<Vec<u8>, ExportError> {
 }
 
 /// Accessors of one vertex buffer (views shared by every level that draws a prefix of it).
+#[derive(Clone, Copy)]
 struct VertexViews {
     positions: json::Index<json::buffer::View>,
     normals: json::Index<json::buffer::View>,
-    uvs: json::Index<json::buffer::View>,
+    uvs: Option<json::Index<json::buffer::View>>,
     colors: json::Index<json::buffer::View>,
     indices: json::Index<json::buffer::View>,
 }
@@ -92,7 +97,9 @@ impl<'a> Builder<'a> {
         })
     }
 
-    fn vertex_views(&mut self, mesh: &TreeMesh) -> VertexViews {
+    /// The buffer views of `mesh`'s attributes; texture coordinates only `with_uvs` (a part
+    /// drawn without a texture gets none, which readers would carry unused).
+    fn vertex_views(&mut self, mesh: &TreeMesh, with_uvs: bool) -> VertexViews {
         use json::buffer::Target::{ArrayBuffer, ElementArrayBuffer};
         let positions = self.view(
             &f32_bytes(mesh.positions.iter().flatten()),
@@ -104,11 +111,13 @@ impl<'a> Builder<'a> {
             Some(ArrayBuffer),
             Some(12),
         );
-        let uvs = self.view(
-            &f32_bytes(mesh.uvs.iter().flatten()),
-            Some(ArrayBuffer),
-            Some(8),
-        );
+        let uvs = with_uvs.then(|| {
+            self.view(
+                &f32_bytes(mesh.uvs.iter().flatten()),
+                Some(ArrayBuffer),
+                Some(8),
+            )
+        });
         let colors: Vec<u8> = mesh
             .ambient
             .iter()
@@ -161,8 +170,10 @@ impl<'a> Builder<'a> {
         attributes.insert(Valid(json::mesh::Semantic::Positions), position);
         let normal = self.accessor(views.normals, num_vertices, F32, Vec3, false, None);
         attributes.insert(Valid(json::mesh::Semantic::Normals), normal);
-        let uv = self.accessor(views.uvs, num_vertices, F32, Vec2, false, None);
-        attributes.insert(Valid(json::mesh::Semantic::TexCoords(0)), uv);
+        if let Some(uvs) = views.uvs {
+            let uv = self.accessor(uvs, num_vertices, F32, Vec2, false, None);
+            attributes.insert(Valid(json::mesh::Semantic::TexCoords(0)), uv);
+        }
         let color = self.accessor(views.colors, num_vertices, U8, Vec4, true, None);
         attributes.insert(Valid(json::mesh::Semantic::Colors(0)), color);
         let indices = self.accessor(views.indices, num_indices, U32, Scalar, false, None);
@@ -287,12 +298,9 @@ fn build(meshes: &TreeMeshes, path: &Path) -> Result<Vec<u8>, ExportError> {
     let leaf = if meshes.leaves.is_empty() {
         None
     } else {
-        let leaf_png = builder.png(
-            "leaf texture",
-            &leaf_texture(meshes.colors.leaf_shape, meshes.colors.leaf, TEXTURE_SIZE),
-        )?;
+        let leaf_png = builder.png("leaf texture", &card_texture(meshes, TEXTURE_SIZE))?;
         let texture = builder.texture("leaf", &leaf_png, json::texture::WrappingMode::ClampToEdge);
-        let views = builder.vertex_views(&meshes.leaves);
+        let views = builder.vertex_views(&meshes.leaves, true);
         Some((
             builder.material("leaf", Some(texture), [1.0; 4], 0.6, true),
             views,
@@ -301,16 +309,17 @@ fn build(meshes: &TreeMeshes, path: &Path) -> Result<Vec<u8>, ExportError> {
     let fruit = if meshes.fruit.is_empty() {
         None
     } else {
-        let views = builder.vertex_views(&meshes.fruit);
+        let views = builder.vertex_views(&meshes.fruit, false);
         Some((
             builder.material("fruit", None, opaque(meshes.colors.fruit), 0.45, false),
             views,
         ))
     };
+    let mut level_nodes = Vec::new();
     for (level, lod) in meshes.lods.iter().enumerate() {
         let mut primitives = Vec::new();
         if !lod.branches.is_empty() {
-            let views = builder.vertex_views(&lod.branches);
+            let views = builder.vertex_views(&lod.branches, true);
             primitives.push(builder.primitive(
                 &lod.branches,
                 &views,
@@ -319,12 +328,15 @@ fn build(meshes: &TreeMeshes, path: &Path) -> Result<Vec<u8>, ExportError> {
             ));
         }
         if let Some((material, views)) = leaf.as_ref().filter(|_| lod.num_leaf_indices > 0) {
-            primitives.push(builder.primitive(
-                &meshes.leaves,
-                views,
-                lod.num_leaf_indices,
-                *material,
-            ));
+            let cards = lod.leaves_in(&meshes.leaves);
+            // The finest level's cards are shared views; a coarse level's merged cards get
+            // their own.
+            let views = if lod.level == 0 {
+                *views
+            } else {
+                builder.vertex_views(cards, true)
+            };
+            primitives.push(builder.primitive(cards, &views, lod.num_leaf_indices, *material));
         }
         if let Some((material, views)) = fruit.as_ref().filter(|_| lod.num_fruit_indices > 0) {
             primitives.push(builder.primitive(
@@ -345,16 +357,29 @@ fn build(meshes: &TreeMeshes, path: &Path) -> Result<Vec<u8>, ExportError> {
             primitives,
             weights: None,
         });
-        let node = builder.root.push(json::Node {
+        level_nodes.push(builder.root.push(json::Node {
             mesh: Some(mesh),
             name: Some(format!("tree_{name}")),
             ..Default::default()
-        });
+        }));
+    }
+    // One scene with one tree: the finest level is a plain mesh node, which readers without
+    // MSFT_lod draw; its MSFT_lod extension lists the coarser levels' nodes, finest first.
+    // The extension is used, not required.
+    if let Some((&finest, coarser)) = level_nodes.split_first() {
+        if !coarser.is_empty() {
+            let ids: Vec<serde_json::Value> = coarser.iter().map(|n| n.value().into()).collect();
+            let mut others = serde_json::Map::new();
+            others.insert(MSFT_LOD.into(), serde_json::json!({ "ids": ids }));
+            builder.root.nodes[finest.value()].extensions =
+                Some(json::extensions::scene::Node { others });
+            builder.root.extensions_used.push(MSFT_LOD.into());
+        }
         builder.root.push(json::Scene {
             extensions: None,
             extras: Default::default(),
-            name: Some(name),
-            nodes: vec![node],
+            name: Some("tree".into()),
+            nodes: vec![finest],
         });
     }
     builder.root.scene = Some(json::Index::new(0));

@@ -5,8 +5,10 @@
 //! textures ([`crate::geometry::textures`]). Units are metres and Y is up, as glTF specifies and
 //! as Sylva's world space already is.
 //!
-//! glTF: one scene per level of detail (`LOD0` the default, then `LOD1`, `LOD2`), each a node
-//! with its own mesh; PBR metallic-roughness materials with embedded PNG textures; ambient light
+//! glTF: one scene holding one tree, the node of the finest level (`tree_LOD0`, a plain mesh
+//! node that every reader draws); its `MSFT_lod` extension (used, not required) lists the nodes
+//! of the coarser levels (`tree_LOD1`, `tree_LOD2`), which are in no scene, so readers without
+//! the extension (Blender 3.4, three.js) show the finest level once; PBR metallic-roughness materials with embedded PNG textures; ambient light
 //! as `COLOR_0`. OBJ: the finest level only, textures written next to it.
 
 mod glb;

@@ -6,7 +6,8 @@ use std::io::{BufWriter, Write};
 use std::path::{Path, PathBuf};
 
 use super::{ExportError, TEXTURE_SIZE};
-use crate::geometry::textures::{bark_texture, leaf_texture, png_bytes};
+use crate::geometry::leaf_card::card_texture;
+use crate::geometry::textures::{bark_texture, png_bytes};
 use crate::geometry::{TreeMesh, TreeMeshes};
 
 /// Writes the finest level of `meshes` to `path` (OBJ), `path` with extension `.mtl`, and the
@@ -37,7 +38,7 @@ pub fn write_obj(meshes: &TreeMeshes, path: &Path) -> Result<(), ExportError> {
     )?;
     write_png(
         &sibling(leaf_name.clone()),
-        &leaf_texture(meshes.colors.leaf_shape, meshes.colors.leaf, TEXTURE_SIZE),
+        &card_texture(meshes, TEXTURE_SIZE),
         "leaf texture",
     )?;
     write_mtl(&sibling(mtl_name.clone()), meshes, &bark_name, &leaf_name)?;

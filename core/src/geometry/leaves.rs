@@ -14,6 +14,7 @@
 use glam::{Vec3, Vec3A};
 use serde::{Deserialize, Serialize};
 
+use super::leaf_card::LeafCard;
 use super::petiole::{Attachment, Blade, Petiole};
 use super::{AmbientFn, NodeGeom, TreeMesh, any_perpendicular, hash_unit};
 use crate::rng::Rng;
@@ -32,6 +33,9 @@ pub struct LeafParams {
     /// Blade length (along the petiole) and width.
     pub length: f32,
     pub width: f32,
+    /// Leaves drawn on one card ([`super::leaf_card`]): a card per `leaves_per_card` leaves.
+    #[serde(default = "super::leaf_card::one_leaf_per_card")]
+    pub leaves_per_card: u32,
     /// Petiole length S.
     pub petiole_length: f32,
     /// Integration steps along the petiole (Δs = S / steps).
@@ -53,6 +57,7 @@ impl Default for LeafParams {
             leaves_per_metre: 30.0,
             length: 0.08,
             width: 0.05,
+            leaves_per_card: 1,
             petiole_length: 0.03,
             petiole_steps: 4,
             insertion_angle: 0.9,
@@ -88,7 +93,7 @@ impl Default for FruitParams {
     }
 }
 
-/// All leaves of the skeleton as quads (4 vertices, 6 indices each) in random order.
+/// All leaf cards of the skeleton as quads (4 vertices, 6 indices each) in random order.
 pub fn build_leaves(
     skeleton: &Skeleton,
     params: &LeafParams,
@@ -99,7 +104,16 @@ pub fn build_leaves(
     NodeGeom::collect_into(skeleton, &mut nodes);
     let mut mesh = TreeMesh::default();
     let mut scratch = LeafScratch::default();
-    build_leaves_into(&nodes, params, seed, ambient, &mut scratch, &mut mesh);
+    let ground_y = skeleton.ground_y();
+    build_leaves_into(
+        &nodes,
+        params,
+        seed,
+        ambient,
+        ground_y,
+        &mut scratch,
+        &mut mesh,
+    );
     mesh
 }
 
@@ -108,6 +122,7 @@ pub fn build_leaves(
 pub(crate) struct LeafScratch {
     slots: Vec<Attachment>,
     spiral: Spiral,
+    card: LeafCard,
 }
 
 /// The phyllotactic spiral: leaf n of a tree (in arena order) turns by n + 1 golden angles, as
@@ -146,12 +161,14 @@ impl Spiral {
 const MAX_LEAVES_PER_INTERNODE: u32 = 4096;
 
 /// [`build_leaves`] into `mesh` (cleared first, capacity reused), with `scratch` as working
-/// memory.
+/// memory. No blade reaches below the ground plane y = `ground_y`: one that would (a weeping
+/// branch's leaves over the lawn) is lifted to lie on it.
 pub(crate) fn build_leaves_into(
     nodes: &[NodeGeom],
     params: &LeafParams,
     seed: u64,
     ambient: AmbientFn,
+    ground_y: f32,
     scratch: &mut LeafScratch,
     mesh: &mut TreeMesh,
 ) {
@@ -162,11 +179,14 @@ pub(crate) fn build_leaves_into(
     slots.clear();
     let mut rng = Rng::new(seed ^ 0x1eaf);
     let spiral = &mut scratch.spiral;
+    let card = &mut scratch.card;
+    card.set(params);
+    let cards_per_metre = params.leaves_per_metre / card.num_leaves() as f32;
     for (index, node) in nodes.iter().enumerate() {
         if node.diameter >= params.max_branch_diameter {
             continue;
         }
-        let expected = params.leaves_per_metre * node.length;
+        let expected = cards_per_metre * node.length;
         let jitter = hash_unit(seed ^ ((index as u64) << 20));
         let count = ((expected + jitter) as u32).min(MAX_LEAVES_PER_INTERNODE);
         if count == 0 {
@@ -209,9 +229,22 @@ pub(crate) fn build_leaves_into(
     }
     mesh.clear();
     mesh.reserve(slots.len() * 4, slots.len() * 6);
-    let petiole = Petiole::new(params);
+    // The petiole carries the card as it would a blade of the card's size. A card of several
+    // leaves is a shoot: its leaves would each turn to the light, which one flat card cannot
+    // show, and turning the whole spray flat to the sky would show the crown edge-on from the
+    // side; so a shoot card keeps the plane its insertion gives it.
+    let shoot = card.num_leaves() > 1;
+    let rate_scale = if shoot { 0.0 } else { 1.0 };
+    let petiole = Petiole::new(&LeafParams {
+        length: card.length_m,
+        width: card.width_m,
+        twist_rate: params.twist_rate * rate_scale,
+        bend_rate: params.bend_rate * rate_scale,
+        turn_rate: params.turn_rate * rate_scale,
+        ..params.clone()
+    });
     for block in slots.chunks(LEAF_BLOCK) {
-        push_blades(mesh, &petiole, block);
+        push_blades(mesh, &petiole, block, ground_y);
     }
 }
 
@@ -219,13 +252,16 @@ pub(crate) fn build_leaves_into(
 /// step and filled in place.
 const LEAF_BLOCK: usize = 64;
 
-/// Appends the blades of the slots `block`, four at a time.
-fn push_blades(mesh: &mut TreeMesh, petiole: &Petiole, block: &[Attachment]) {
+/// Appends the blades of the slots `block`, four at a time, none below y = `ground_y`.
+fn push_blades(mesh: &mut TreeMesh, petiole: &Petiole, block: &[Attachment], ground_y: f32) {
     let base = mesh.positions.len() as u32;
     let (positions, normals, uvs, ambient) = mesh.grow_vertices(4 * block.len());
     let mut write = |leaf: usize, blade: &Blade, light: f32| {
         let range = 4 * leaf..4 * leaf + 4;
-        positions[range.clone()].copy_from_slice(&blade.corners);
+        let lowest = blade.corners.iter().fold(f32::INFINITY, |y, c| y.min(c[1]));
+        let lift = (ground_y - lowest).max(0.0);
+        let corners = blade.corners.map(|[x, y, z]| [x, y + lift, z]);
+        positions[range.clone()].copy_from_slice(&corners);
         normals[range.clone()].fill(blade.normal);
         uvs[range.clone()].copy_from_slice(&[[0.0, 1.0], [1.0, 1.0], [0.0, 0.0], [1.0, 0.0]]);
         ambient[range].fill(light);
@@ -252,8 +288,54 @@ fn push_blades(mesh: &mut TreeMesh, petiole: &Petiole, block: &[Attachment]) {
         write(leaf, &petiole.blade(slot), slot.light);
         leaf += 1;
     }
-    // Counter-clockwise seen from the normal's side (H × L = U): base-left, tip-left, tip-right.
-    let indices = mesh.grow_indices(6 * block.len());
+    push_quad_indices(mesh, base, block.len());
+}
+
+/// The first `num_cards` cards of `cards` (the leaf buffer, in random order), each scaled by
+/// 1/√`fraction` about the midpoint of its base edge, into `out` (cleared first): a coarse
+/// level of detail's cards, standing for `1/fraction` times as many finer ones with the same
+/// total area, none below y = `ground_y`.
+pub(crate) fn merge_cards_into(
+    cards: &TreeMesh,
+    num_cards: usize,
+    fraction: f32,
+    ground_y: f32,
+    out: &mut TreeMesh,
+) {
+    out.clear();
+    let num_cards = num_cards.min(cards.indices.len() / 6);
+    let scale = 1.0 / fraction.clamp(1e-3, 1.0).sqrt();
+    out.reserve(4 * num_cards, 6 * num_cards);
+    let (positions, normals, uvs, ambient) = out.grow_vertices(4 * num_cards);
+    let n = 4 * num_cards;
+    // The leaf buffer holds card k's four vertices at 4k.
+    normals.copy_from_slice(&cards.normals[..n]);
+    uvs.copy_from_slice(&cards.uvs[..n]);
+    ambient.copy_from_slice(&cards.ambient[..n]);
+    for (card, out_card) in cards.positions[..n]
+        .chunks_exact(4)
+        .zip(positions.chunks_exact_mut(4))
+    {
+        let base = (Vec3::from(card[0]) + Vec3::from(card[1])) * 0.5;
+        let mut lowest = f32::INFINITY;
+        for (corner, out_corner) in card.iter().zip(out_card.iter_mut()) {
+            let p = base + (Vec3::from(*corner) - base) * scale;
+            lowest = lowest.min(p.y);
+            *out_corner = p.to_array();
+        }
+        let lift = (ground_y - lowest).max(0.0);
+        for corner in out_card.iter_mut() {
+            corner[1] += lift;
+        }
+    }
+    push_quad_indices(out, 0, num_cards);
+}
+
+/// Appends the indices of `num_quads` quads whose 4 vertices each (base-left, base-right,
+/// tip-left, tip-right) start at vertex `base`: counter-clockwise seen from the normal's side
+/// (H × L = U).
+pub(crate) fn push_quad_indices(mesh: &mut TreeMesh, base: u32, num_quads: usize) {
+    let indices = mesh.grow_indices(6 * num_quads);
     for (quad, corner) in indices.chunks_exact_mut(6).zip((base..).step_by(4)) {
         quad.copy_from_slice(&[
             corner,
@@ -292,7 +374,7 @@ pub fn build_fruit_into(
     for (index, node) in skeleton.internodes.iter().enumerate() {
         fruit_centers(node, index as u32, params, &mut centers);
     }
-    push_fruit(mesh, &centers, params, ambient);
+    push_fruit(mesh, &centers, params, ambient, skeleton.ground_y());
 }
 
 /// Appends the centres of the fruit on the buds of `node` (arena index `index`) to `centers`,
@@ -325,14 +407,17 @@ pub(crate) fn fruit_centers(
     }
 }
 
-/// The fruit at `centers` appended to `mesh`.
+/// The fruit at `centers` appended to `mesh`, lifted where needed to rest on the ground plane
+/// y = `ground_y` rather than sink into it.
 pub(crate) fn push_fruit(
     mesh: &mut TreeMesh,
     centers: &[Vec3],
     params: &FruitParams,
     ambient: AmbientFn,
+    ground_y: f32,
 ) {
     for &center in centers {
+        let center = center.with_y(center.y.max(ground_y + params.radius));
         push_icosahedron(mesh, center, params.radius, ambient(center).clamp(0.0, 1.0));
     }
 }

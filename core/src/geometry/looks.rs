@@ -182,6 +182,9 @@ pub struct Looks {
     pub leaves_per_metre: f32,
     /// Leaves on branches thinner than this many tip diameters (`tip_diameter_m`).
     pub leafy_diameters: f32,
+    /// Leaves drawn on one card (a spray of small leaves, a needle shoot; see
+    /// [`super::leaf_card`]).
+    pub leaves_per_card: u32,
     /// Keeps its leaves in winter (conifers); deciduous trees stand leafless.
     pub evergreen: bool,
     pub leaf_color: SeasonColors,
@@ -196,8 +199,9 @@ impl Default for Looks {
             leaf_shape: LeafShape::Elliptic,
             leaf_length: 0.09,
             leaf_width: 0.06,
-            leaves_per_metre: 28.0,
-            leafy_diameters: 3.5,
+            leaves_per_metre: 120.0,
+            leafy_diameters: 10.0,
+            leaves_per_card: 8,
             evergreen: false,
             leaf_color: SeasonColors::default(),
             bark: BarkLook::default(),
@@ -237,6 +241,13 @@ impl Looks {
                     "{name} must be a number from {lo} to {hi}, got {v}"
                 ));
             }
+        }
+        let max_card = super::leaf_card::MAX_LEAVES_PER_CARD;
+        if !(1..=max_card).contains(&self.leaves_per_card) {
+            return Err(format!(
+                "looks.leaves_per_card must be a whole number from 1 to {max_card}, got {}",
+                self.leaves_per_card
+            ));
         }
         let c = &self.leaf_color;
         let mut colors = vec![
@@ -298,6 +309,7 @@ pub fn mesh_params_in(species: &Species, season: Season) -> MeshParams {
             },
             length: look.leaf_length,
             width: look.leaf_width,
+            leaves_per_card: look.leaves_per_card,
             petiole_length: 0.3 * look.leaf_length,
             ..LeafParams::default()
         },

@@ -66,6 +66,7 @@ impl Mesher {
         meshes: &mut TreeMeshes,
     ) {
         self.collect(skeleton, params.fruit.as_ref());
+        let ground_y = skeleton.ground_y();
         self.topology.build_with_links(&self.links, &self.diameters);
         self.frames
             .build_into(&self.nodes, &self.topology, params, ambient);
@@ -74,22 +75,41 @@ impl Mesher {
             &params.leaves,
             params.seed,
             ambient,
+            ground_y,
             &mut self.leaf_scratch,
             &mut meshes.leaves,
         );
         meshes.fruit.clear();
         if let Some(fruit) = &params.fruit {
-            leaves::push_fruit(&mut meshes.fruit, &self.fruit_centers, fruit, ambient);
+            leaves::push_fruit(
+                &mut meshes.fruit,
+                &self.fruit_centers,
+                fruit,
+                ambient,
+                ground_y,
+            );
         }
         let levels = levels.range();
         meshes.lods.resize_with(levels.len(), Lod::default);
         for (lod, level) in meshes.lods.iter_mut().zip(levels) {
             self.mesh_level(level, lod);
-            lod.num_leaf_indices =
-                prefix_indices(meshes.leaves.indices.len(), 6, lod.target_fraction);
+            let num_cards = prefix_indices(meshes.leaves.indices.len(), 6, lod.target_fraction);
+            if level == 0 {
+                lod.merged_leaves.clear();
+            } else {
+                leaves::merge_cards_into(
+                    &meshes.leaves,
+                    num_cards / 6,
+                    lod.target_fraction,
+                    ground_y,
+                    &mut lod.merged_leaves,
+                );
+            }
+            lod.num_leaf_indices = num_cards;
             lod.num_fruit_indices =
                 prefix_indices(meshes.fruit.indices.len(), 3, lod.target_fraction);
         }
+        meshes.leaf_card.set(&params.leaves);
         meshes.colors = MaterialColors {
             bark: params.bark_color,
             leaf: params.leaf_color,

@@ -62,32 +62,66 @@ pub fn validate_glb(path: &Path) -> ValidatorReport {
     }
 }
 
-/// Re-imports `path` with the `gltf` crate and checks, per level of detail (one scene each),
-/// the triangle count and bounds against `meshes`, plus textured bark and leaf materials.
+/// The nodes of the levels of detail of a glTF document, finest first: the one node of its one
+/// scene, then the nodes its `MSFT_lod` extension lists (read from the JSON chunk of `glb`).
+pub fn lod_nodes<'a>(document: &'a gltf::Document, glb: &[u8]) -> Vec<gltf::Node<'a>> {
+    assert_eq!(document.scenes().count(), 1, "one scene");
+    let scene = document.scenes().next().expect("a scene");
+    let roots: Vec<gltf::Node> = scene.nodes().collect();
+    assert_eq!(roots.len(), 1, "one tree in the scene");
+    let json_length = u32::from_le_bytes(glb[12..16].try_into().expect("GLB header")) as usize;
+    let json: serde_json::Value =
+        serde_json::from_slice(&glb[20..20 + json_length]).expect("the JSON chunk parses");
+    let finest = roots[0].index();
+    let ids: Vec<usize> = json["nodes"][finest]["extensions"]["MSFT_lod"]["ids"]
+        .as_array()
+        .map(|ids| {
+            ids.iter()
+                .map(|i| i.as_u64().expect("a node id") as usize)
+                .collect()
+        })
+        .unwrap_or_default();
+    let mut nodes = vec![roots[0].clone()];
+    nodes.extend(
+        ids.into_iter()
+            .map(|i| document.nodes().nth(i).expect("an LOD node")),
+    );
+    nodes
+}
+
+/// Re-imports `path` with the `gltf` crate and checks, per level of detail (the scene's one
+/// node and its `MSFT_lod` levels), the triangle count and bounds against `meshes`, plus
+/// textured bark and leaf materials.
 pub fn assert_reimport_matches(path: &Path, meshes: &TreeMeshes) {
     let (document, buffers, images) = gltf::import(path).expect("the glb imports");
+    let glb = std::fs::read(path).expect("the glb reads");
+    let levels = lod_nodes(&document, &glb);
     assert_eq!(
-        document.scenes().count(),
+        levels.len(),
         meshes.lods.len(),
-        "one scene per level of detail"
+        "a node per level of detail"
     );
     assert_eq!(document.default_scene().map(|s| s.index()), Some(0));
-    for (level, scene) in document.scenes().enumerate() {
+    for (level, node) in levels.iter().enumerate() {
         let mut triangles = 0;
         let mut lo = glam::Vec3::splat(f32::INFINITY);
         let mut hi = glam::Vec3::splat(f32::NEG_INFINITY);
-        for node in scene.nodes() {
-            let mesh = node.mesh().expect("a mesh per level");
-            for primitive in mesh.primitives() {
-                let reader = primitive.reader(|b| Some(&buffers[b.index()]));
-                triangles += reader.read_indices().expect("indexed").into_u32().count() / 3;
-                let positions: Vec<[f32; 3]> =
-                    reader.read_positions().expect("positions").collect();
-                assert!(reader.read_normals().is_some() && reader.read_tex_coords(0).is_some());
-                for p in positions {
-                    lo = lo.min(p.into());
-                    hi = hi.max(p.into());
-                }
+        let mesh = node.mesh().expect("a mesh per level");
+        for primitive in mesh.primitives() {
+            let reader = primitive.reader(|b| Some(&buffers[b.index()]));
+            triangles += reader.read_indices().expect("indexed").into_u32().count() / 3;
+            let positions: Vec<[f32; 3]> = reader.read_positions().expect("positions").collect();
+            assert!(reader.read_normals().is_some());
+            // Only textured parts carry texture coordinates (the fruit has none).
+            let textured = primitive
+                .material()
+                .pbr_metallic_roughness()
+                .base_color_texture()
+                .is_some();
+            assert_eq!(reader.read_tex_coords(0).is_some(), textured);
+            for p in positions {
+                lo = lo.min(p.into());
+                hi = hi.max(p.into());
             }
         }
         assert_eq!(
@@ -196,4 +230,36 @@ pub fn mean_rise(tree: &sylva_core::Tree, orders: std::ops::RangeInclusive<u32>)
 pub fn median(mut values: Vec<f32>) -> f32 {
     values.sort_by(f32::total_cmp);
     values[values.len() / 2]
+}
+
+/// The lowest height of any vertex of `mesh` (+∞ for an empty mesh).
+pub fn lowest_y(mesh: &sylva_core::geometry::TreeMesh) -> f32 {
+    mesh.positions
+        .iter()
+        .fold(f32::INFINITY, |y, p| y.min(p[1]))
+}
+
+/// What glTF Transform (`node tools/gltf-reader/read.mjs`, a real reader) finds in `path`: its
+/// JSON report. Panics, loudly, when node or the package is missing: the check must never be
+/// skipped silently.
+pub fn read_glb_with_gltf_transform(path: &Path) -> serde_json::Value {
+    let script = workspace_root().join("tools/gltf-reader/read.mjs");
+    let package = workspace_root().join("tools/gltf-reader/node_modules/@gltf-transform/core");
+    assert!(
+        package.is_dir(),
+        "glTF Transform is not installed: run `bash scripts/setup.sh` (npm install in \
+         tools/gltf-reader)"
+    );
+    let output = Command::new("node")
+        .arg(&script)
+        .arg(path)
+        .output()
+        .expect("node runs (install nodejs)");
+    assert!(
+        output.status.success(),
+        "glTF Transform failed on {}: {}",
+        path.display(),
+        String::from_utf8_lossy(&output.stderr)
+    );
+    serde_json::from_slice(&output.stdout).expect("the reader prints JSON")
 }
