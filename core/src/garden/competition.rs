@@ -12,10 +12,12 @@
 //! Integer sums: the grid is exactly i's own shade plus that of its linked neighbours' current
 //! nodes, whatever the order.
 //!
-//! **Space.** Before each round a tree due to grow gets the nodes of its linked neighbours that
-//! lie within its reach, in its own space, as occupied space.
+//! **Space.** Before each round a tree due to grow gets, as occupied space in its own space, the
+//! nodes of its linked neighbours close enough to take an attraction point from it.
 
-use glam::{Vec2, Vec3};
+use std::collections::HashSet;
+
+use glam::{IVec3, Vec2, Vec3};
 use rayon::prelude::*;
 
 use super::{Garden, GardenTree};
@@ -113,10 +115,32 @@ pub(super) fn link_neighbours(garden: &mut Garden) {
         });
 }
 
-/// Gives every tree that is `due` the nodes of its linked neighbours within its reach, in its
-/// own space; the others keep none (they do not grow this round).
+/// Cells of `size` metres holding the places where tree `t` (its own space) can take
+/// attraction points this iteration: its nodes with a living bud and its persistent points.
+fn contact_cells(t: &GardenTree, size: f32) -> HashSet<IVec3> {
+    let cell = |p: Vec3| (p / size).floor().as_ivec3();
+    let tree = &t.tree;
+    let buds = tree.skeleton.internodes.iter().filter(|n| {
+        n.terminal_bud.as_ref().is_some_and(|b| b.alive) || n.lateral_buds.iter().any(|b| b.alive)
+    });
+    buds.map(|n| cell(n.end))
+        .chain(
+            tree.environment
+                .attraction
+                .points
+                .iter()
+                .map(|p| cell(p.position)),
+        )
+        .collect()
+}
+
+/// Gives every tree that is `due` the nodes of its linked neighbours that can take an
+/// attraction point from it, in its own space; the others keep none (they do not grow this
+/// round). A point a bud can win lies within the perception radius of it (or is a persistent
+/// point), and a neighbour's node takes it only within its occupancy radius r: so only nodes
+/// within r + perception of a node with a living bud, or of a persistent point, matter. They
+/// are found through cells of that size (the cell of each node and the 26 around it).
 pub(super) fn gather_neighbour_nodes(garden: &mut Garden, due: &[bool]) {
-    let boxes: Vec<(Vec2, Vec2)> = garden.trees.par_iter().map(crown_box).collect();
     let gathered: Vec<Vec<Vec3>> = (0..garden.trees.len())
         .into_par_iter()
         .map(|i| {
@@ -124,9 +148,11 @@ pub(super) fn gather_neighbour_nodes(garden: &mut Garden, due: &[bool]) {
                 return Vec::new();
             }
             let t = &garden.trees[i];
-            let (lo, hi) = boxes[i];
-            let reach = reach_m(t);
-            let (lo, hi) = (lo - Vec2::splat(reach), hi + Vec2::splat(reach));
+            let s = &t.tree.species;
+            let size = (2.0 * s.occupancy_radius_internodes + s.perception_distance_internodes)
+                * s.internode_length_m
+                + REACH_SLACK_M;
+            let cells = contact_cells(t, size);
             let base = t.base();
             let mut nodes = Vec::new();
             for &j in &t.neighbours {
@@ -134,8 +160,13 @@ pub(super) fn gather_neighbour_nodes(garden: &mut Garden, due: &[bool]) {
                 let offset = n.base() - base;
                 for node in &n.tree.skeleton.internodes {
                     let p = node.end + offset;
-                    let (x, z) = (p.x + base.x, p.z + base.z);
-                    if x >= lo.x && x <= hi.x && z >= lo.y && z <= hi.y {
+                    let c = (p / size).floor().as_ivec3();
+                    let near = (-1..=1).any(|dx| {
+                        (-1..=1).any(|dy| {
+                            (-1..=1).any(|dz| cells.contains(&(c + IVec3::new(dx, dy, dz))))
+                        })
+                    });
+                    if near {
                         nodes.push(p);
                     }
                 }
