@@ -8,40 +8,17 @@
 use std::time::Instant;
 
 use glam::Vec2;
-use sylva_core::garden::{Garden, Layout, Planting, PlantingFile, RIPLEY_RADIUS_M, ripley_excess};
-use sylva_core::species::Species;
+use sylva_core::garden::{RIPLEY_RADIUS_M, ripley_excess};
 
-/// The mixed presets, taken in turn.
-const PRESETS: [&str; 6] = [
-    "birch",
-    "maple",
-    "oak",
-    "norway_spruce",
-    "weeping_willow",
-    "lombardy_poplar",
-];
+#[path = "../benches/common/garden_stands.rs"]
+mod garden_stands;
+use garden_stands::stand;
 
 fn digest(bytes: &[u8]) -> String {
     let hash = bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {
         (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
     });
     format!("{hash:016x}")
-}
-
-fn stand(count: usize, side_m: f32, seed: u64) -> Garden {
-    let file = PlantingFile {
-        plantings: vec![Planting::Stand {
-            species: PRESETS.iter().map(|s| s.to_string()).collect(),
-            width_m: side_m,
-            depth_m: side_m,
-            count,
-            layout: Layout::Random,
-            age_years: 0.0,
-            seed,
-        }],
-    };
-    let by_name = |name: &str| Species::by_name(name).map_err(|e| e.to_string());
-    Garden::plant(file.trees(&by_name).expect("a valid stand")).expect("plants")
 }
 
 fn main() {
