@@ -175,6 +175,32 @@ impl Garden {
             });
     }
 
+    /// Edits tree `index` (a brush stroke, a prune, a bend, new parameters, more years: whatever
+    /// `edit` does to it) against its neighbours as they stand, then hands the change of its
+    /// nodes on to the shade of the trees it reaches. No other tree grows or changes; only their
+    /// environments follow. Returns false (and does nothing) for an index past the trees.
+    pub fn edit_tree(&mut self, index: usize, edit: impl FnOnce(&mut Tree)) -> bool {
+        if index >= self.trees.len() {
+            return false;
+        }
+        if !self.competition {
+            edit(&mut self.trees[index].tree);
+            return true;
+        }
+        let mut due = vec![false; self.trees.len()];
+        due[index] = true;
+        competition::link_neighbours(self);
+        competition::gather_neighbour_nodes(self, &due);
+        competition::set_neighbour_tropisms(self);
+        let before = competition::node_ends(&self.trees[index]);
+        edit(&mut self.trees[index].tree);
+        let mut changes: Vec<Option<competition::NodeChanges>> =
+            (0..self.trees.len()).map(|_| None).collect();
+        changes[index] = Some(competition::NodeChanges::of(&self.trees[index], &before));
+        competition::hand_on_shade(self, &changes);
+        true
+    }
+
     /// The trees' environments as they were grown: each tree's own shade (rebuilt on load)
     /// plus that of its linked neighbours. Call after loading or changing trees by hand.
     pub fn rebuild_environment(&mut self) {

@@ -237,3 +237,40 @@ fn a_saved_garden_loads_back_and_grows_on_as_if_never_saved() {
     loaded.grow_years(3.0);
     assert_eq!(digest(&garden), digest(&loaded));
 }
+
+#[test]
+fn editing_one_tree_of_ten_leaves_the_other_nine_byte_identical() {
+    let mut garden = small_stand(3);
+    garden.grow_years(6.0);
+    let files = |g: &Garden| -> Vec<Vec<u8>> {
+        g.trees
+            .iter()
+            .map(|t| t.tree.to_json_bytes().expect("saves"))
+            .collect()
+    };
+    let before = files(&garden);
+    let edited = 4;
+    // A prune of the first branch, a parameter change and two more years for that tree alone.
+    assert!(garden.edit_tree(edited, |tree| {
+        let branch = (1..tree.skeleton.len())
+            .find(|&i| tree.skeleton.internodes[i].order == 1)
+            .map(|i| sylva_core::NodeId(i as u32));
+        tree.remove_subtrees(&branch.into_iter().collect::<Vec<_>>());
+        tree.species.apical_dominance *= 0.9;
+        tree.grow_years(2.0);
+    }));
+    let after = files(&garden);
+    for (i, (b, a)) in before.iter().zip(&after).enumerate() {
+        if i == edited {
+            assert_ne!(b, a, "the edited tree changed");
+        } else {
+            assert_eq!(b, a, "tree {i} changed");
+        }
+    }
+    assert!(!garden.edit_tree(10, |_| {}));
+    // The others' environments took in the edit: growing on, the garden matches a reloaded one.
+    let mut reloaded = Garden::from_json_bytes(&garden.to_json_bytes()).expect("loads");
+    garden.grow_years(2.0);
+    reloaded.grow_years(2.0);
+    assert_eq!(digest(&garden), digest(&reloaded));
+}
