@@ -115,15 +115,17 @@ pub(super) fn link_neighbours(garden: &mut Garden) {
         });
 }
 
-/// Cells of `size` metres holding the places where tree `t` (its own space) can take
-/// attraction points this iteration: its nodes with a living bud and its persistent points.
+/// Cells of `size` metres holding, or next to one holding, a place where tree `t` (its own
+/// space) can take attraction points this iteration: its nodes with a living bud and its
+/// persistent points.
 fn contact_cells(t: &GardenTree, size: f32) -> HashSet<IVec3> {
     let cell = |p: Vec3| (p / size).floor().as_ivec3();
     let tree = &t.tree;
     let buds = tree.skeleton.internodes.iter().filter(|n| {
         n.terminal_bud.as_ref().is_some_and(|b| b.alive) || n.lateral_buds.iter().any(|b| b.alive)
     });
-    buds.map(|n| cell(n.end))
+    let own: HashSet<IVec3> = buds
+        .map(|n| cell(n.end))
         .chain(
             tree.environment
                 .attraction
@@ -131,7 +133,19 @@ fn contact_cells(t: &GardenTree, size: f32) -> HashSet<IVec3> {
                 .iter()
                 .map(|p| cell(p.position)),
         )
-        .collect()
+        .collect();
+    // Each cell with the 26 around it, so that a neighbour's node needs one look-up.
+    let mut cells = HashSet::with_capacity(own.len() * 4);
+    for c in own {
+        for dx in -1..=1 {
+            for dy in -1..=1 {
+                for dz in -1..=1 {
+                    cells.insert(c + IVec3::new(dx, dy, dz));
+                }
+            }
+        }
+    }
+    cells
 }
 
 /// Gives every tree that is `due` the nodes of its linked neighbours that can take an
@@ -139,7 +153,7 @@ fn contact_cells(t: &GardenTree, size: f32) -> HashSet<IVec3> {
 /// round). A point a bud can win lies within the perception radius of it (or is a persistent
 /// point), and a neighbour's node takes it only within its occupancy radius r: so only nodes
 /// within r + perception of a node with a living bud, or of a persistent point, matter. They
-/// are found through cells of that size (the cell of each node and the 26 around it).
+/// are found through cells of that size (the cell of each such node and the 26 around it).
 pub(super) fn gather_neighbour_nodes(garden: &mut Garden, due: &[bool]) {
     let gathered: Vec<Vec<Vec3>> = (0..garden.trees.len())
         .into_par_iter()
@@ -153,6 +167,10 @@ pub(super) fn gather_neighbour_nodes(garden: &mut Garden, due: &[bool]) {
                 * s.internode_length_m
                 + REACH_SLACK_M;
             let cells = contact_cells(t, size);
+            let (lo, hi) = cells.iter().fold(
+                (IVec3::splat(i32::MAX), IVec3::splat(i32::MIN)),
+                |(lo, hi), &c| (lo.min(c), hi.max(c)),
+            );
             let base = t.base();
             let mut nodes = Vec::new();
             for &j in &t.neighbours {
@@ -161,12 +179,7 @@ pub(super) fn gather_neighbour_nodes(garden: &mut Garden, due: &[bool]) {
                 for node in &n.tree.skeleton.internodes {
                     let p = node.end + offset;
                     let c = (p / size).floor().as_ivec3();
-                    let near = (-1..=1).any(|dx| {
-                        (-1..=1).any(|dy| {
-                            (-1..=1).any(|dz| cells.contains(&(c + IVec3::new(dx, dy, dz))))
-                        })
-                    });
-                    if near {
+                    if c.cmpge(lo).all() && c.cmple(hi).all() && cells.contains(&c) {
                         nodes.push(p);
                     }
                 }
