@@ -13,7 +13,13 @@
 //!   the same whatever the order the pyramids arrive in);
 //! - **space**: the neighbours' nodes within reach occupy space as the tree's own do
 //!   ([`crate::environment::Environment::neighbour_nodes`]): no bud takes the space a
-//!   neighbour's internodes hold.
+//!   neighbour's internodes hold;
+//! - **neighbourhood asymmetry**: the pressure of the trees around (Longay 2014 eq. 6.3–6.5)
+//!   tilts the tree's shoots away from its neighbours while it is young
+//!   ([`crate::environment::Environment::neighbour_tropism`]).
+//!
+//! [`Garden::edit_tree`] edits one tree against its neighbours as they stand; the others do not
+//! change, only their environments take in the edited tree's new nodes.
 //!
 //! Within a round the trees grow in parallel (rayon); each reads only its own environment, made
 //! before the round, so the garden is the same whatever the number of threads. A garden of one
