@@ -15,6 +15,9 @@ pub enum Command {
     Species,
     /// Grows a tree autonomously and saves it; ends with a key=value summary line.
     Grow(crate::cmd_grow::GrowArgs),
+    /// Plants several trees and grows them together, competing for light and space; ends with a
+    /// key=value summary line.
+    Garden(crate::cmd_garden::GardenArgs),
     /// Replays a recorded session headlessly: composited PNG frames and the final tree in --out.
     Replay(crate::cmd_app::ReplayArgs),
     /// Opens a window on a recorded sequence, a video file or `--camera N`.
@@ -28,6 +31,7 @@ pub fn main() -> anyhow::Result<()> {
     match cli.command {
         Some(Command::Species) => crate::cmd_grow::species(),
         Some(Command::Grow(args)) => crate::cmd_grow::grow(args),
+        Some(Command::Garden(args)) => crate::cmd_garden::garden(args),
         Some(Command::Replay(args)) => crate::cmd_app::replay_command(args),
         Some(Command::View(args)) => crate::cmd_app::view(args),
         Some(Command::Track(args)) => crate::cmd_track::track(args),

@@ -55,7 +55,8 @@ pub fn species() -> anyhow::Result<()> {
     Ok(())
 }
 
-fn load_species(name_or_file: &str) -> anyhow::Result<Species> {
+/// A preset by name, else a species file.
+pub(crate) fn load_species(name_or_file: &str) -> anyhow::Result<Species> {
     match Species::by_name(name_or_file) {
         Ok(s) => Ok(s),
         Err(preset_error) => {

@@ -6,6 +6,7 @@
 pub mod autosave;
 pub mod cli;
 pub mod cmd_app;
+pub mod cmd_garden;
 pub mod cmd_grow;
 pub mod cmd_track;
 pub mod demo_script;

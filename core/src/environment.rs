@@ -37,6 +37,18 @@ pub struct Environment {
     /// at once.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub depth_constraint: Option<DepthConstraint>,
+    /// Nodes (internode ends) of neighbouring trees in a garden, in this tree's space: their
+    /// occupancy spheres take attraction points away as the tree's own nodes do, so no bud
+    /// takes space a neighbour occupies. Set by [`crate::garden`] before each iteration; empty
+    /// for a tree growing alone. Derived, never saved.
+    #[serde(skip)]
+    pub neighbour_nodes: Vec<glam::Vec3>,
+    /// The neighbourhood asymmetry tropism of a garden tree, (1 − α)·V_i of Longay 2014
+    /// eq. 6.5: added to every shoot's tropism T (unless a stroke or an edit chose it), so the
+    /// tree leans away from its neighbours while young. Zero for a tree growing alone. Set by
+    /// [`crate::garden`] before each iteration; derived, never saved.
+    #[serde(skip)]
+    pub neighbour_tropism: glam::Vec3,
 }
 
 impl Environment {

@@ -13,11 +13,13 @@
 //! Modules, one concept each: [`tree`] (arena of internodes and buds, frames), [`environment`]
 //! (attraction points, shadow grid, scenes), [`growth`] (one iteration, step by step),
 //! [`species`] (presets as data), [`edit`] (brush, lasso, prune, bend, widths, history),
-//! [`geometry`] (branch and leaf meshes), [`export`] (glTF 2.0, OBJ).
+//! [`geometry`] (branch and leaf meshes), [`export`] (glTF 2.0, OBJ), [`garden`] (several trees
+//! growing together, competing for light and space).
 
 pub mod edit;
 pub mod environment;
 pub mod export;
+pub mod garden;
 pub mod geometry;
 pub mod growth;
 pub mod rng;

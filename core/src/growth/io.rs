@@ -58,6 +58,18 @@ struct FileIn {
     tree: Tree,
 }
 
+/// Writes `bytes` to a temporary file next to `path`, then renames it over `path`: a reader
+/// sees the old file or the new one, never a part.
+pub(crate) fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
+    let mut temp_name = path.file_name().unwrap_or_default().to_os_string();
+    temp_name.push(".tmp");
+    let temp = path.with_file_name(temp_name);
+    std::fs::write(&temp, bytes)?;
+    std::fs::rename(&temp, path).inspect_err(|_| {
+        let _ = std::fs::remove_file(&temp);
+    })
+}
+
 impl Tree {
     /// The tree as versioned JSON bytes (deterministic).
     pub fn to_json_bytes(&self) -> Result<Vec<u8>, TreeFileError> {
@@ -144,20 +156,9 @@ impl Tree {
             },
             other => other,
         })?;
-        let mut temp_name = path.file_name().unwrap_or_default().to_os_string();
-        temp_name.push(".tmp");
-        let temp = path.with_file_name(temp_name);
-        let write_err = |source| TreeFileError::Write {
-            path: shown.clone(),
+        write_atomically(path, &bytes).map_err(|source| TreeFileError::Write {
+            path: shown,
             source,
-        };
-        std::fs::write(&temp, &bytes).map_err(write_err)?;
-        std::fs::rename(&temp, path).map_err(|source| {
-            let _ = std::fs::remove_file(&temp);
-            TreeFileError::Write {
-                path: shown.clone(),
-                source,
-            }
         })
     }
 

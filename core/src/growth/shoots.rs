@@ -214,7 +214,12 @@ fn grow_shoot(
             environment = e;
             carried = t.or(carried);
         }
-        let t = tropism(tree, constants, heading, order, bud_override.or(carried));
+        let mut t = tropism(tree, constants, heading, order, bud_override.or(carried));
+        // A garden's neighbourhood asymmetry (Longay 2014 eq. 6.5: F = S_t + (1 − α)·V).
+        let asymmetry = tree.environment.neighbour_tropism;
+        if asymmetry != Vec3::ZERO && bud_override.or(carried).is_none() {
+            t = (t + asymmetry).try_normalize().unwrap_or(t);
+        }
         // A stroke's direction (sketch tropism) weighs at least what the stroke asks for.
         let beta = match (bud_override, carried) {
             (None, Some(_)) => beta.max(tree.environment.attraction.sketch_tropism_weight),

@@ -84,6 +84,14 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
     scratch
         .positions
         .extend(scratch.node_end.iter().copied().filter(|&e| near(e, r)));
+    // A garden's neighbours occupy space too (none for a tree growing alone).
+    scratch.positions.extend(
+        tree.environment
+            .neighbour_nodes
+            .iter()
+            .copied()
+            .filter(|&e| near(e, r)),
+    );
     scratch.node_grid.rebuild_for_gathers(&scratch.positions, r);
     // The point grid serves the shoots later (perception, consumption); built now, its cell
     // order also orders the queries below so that neighbouring queries share cached cells.
