@@ -335,7 +335,9 @@ pub fn replay(
         if meshed_revision != Some(state.revision) {
             // Nothing is shown before the tree is planted.
             match state.is_planted() {
-                true => renderer.set_tree(gpu, tree_mesher.mesh_in(&state.tree, state.params.season)),
+                true => {
+                    renderer.set_tree(gpu, tree_mesher.mesh_in(&state.tree, state.params.season))
+                }
                 false => renderer.set_tree(gpu, &Default::default()),
             }
             meshed_revision = Some(state.revision);

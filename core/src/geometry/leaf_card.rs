@@ -188,9 +188,10 @@ impl LeafCard {
 /// The texture of the leaf cards of `meshes`, `size` × `size`: their layout drawn from the
 /// species' leaf texture. What exports embed and crown measures alpha-test.
 pub fn card_texture(meshes: &TreeMeshes, size: u32) -> RgbaImage {
-    meshes
-        .leaf_card
-        .texture(&leaf_texture(meshes.colors.leaf_shape, meshes.colors.leaf, size), size)
+    meshes.leaf_card.texture(
+        &leaf_texture(meshes.colors.leaf_shape, meshes.colors.leaf, size),
+        size,
+    )
 }
 
 /// Corners of a leaf of length `l` and width `w` in card space: base-left, base-right,
