@@ -130,16 +130,14 @@ pub fn sylva_ui(
         .show(ui, |ui| {
             side_bar_ui(ui, &mut params, design, events);
         });
-    egui::Panel::bottom("sylva playback").show(ui, |ui| {
-        playback_ui(ui, state);
-        scale_ui::status_line_ui(ui, design);
-    });
+    egui::Panel::bottom("sylva playback").show(ui, |ui| playback_ui(ui, state));
     if params != design.params {
         events.push(InputEvent::Parameters { parameters: params });
     }
     let view = ui.available_rect_before_wrap();
     overlays_ui(ui, state, view);
     scale_ui::overlay_ui(ui, design, view);
+    scale_ui::status_line_ui(ui, design, view);
     view
 }
 

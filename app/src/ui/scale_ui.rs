@@ -63,13 +63,25 @@ pub fn scale_ui(
     }
 }
 
-/// The status line: the scale's source and uncertainty, always shown.
-pub fn status_line_ui(ui: &mut Ui, design: &DesignState) {
-    ui.label(
-        RichText::new(design.scale.state.status())
-            .size(15.0)
-            .strong(),
-    );
+/// The status line, always shown over the view's top-left corner (taking no room from it): the
+/// scale's source and uncertainty.
+pub fn status_line_ui(ui: &Ui, design: &DesignState, view: egui::Rect) {
+    egui::Area::new(egui::Id::unique("sylva scale status"))
+        .fixed_pos(view.left_top() + egui::vec2(8.0, 8.0))
+        .interactable(false)
+        .show(ui.ctx(), |ui| {
+            egui::Frame::new()
+                .fill(Color32::from_black_alpha(170))
+                .corner_radius(6.0)
+                .inner_margin(6.0)
+                .show(ui, |ui| {
+                    ui.label(
+                        RichText::new(design.scale.state.status())
+                            .size(15.0)
+                            .color(Color32::WHITE),
+                    );
+                });
+        });
 }
 
 /// The last distance measured, large on the view while the measure tool is chosen.
