@@ -4,15 +4,15 @@
 //!
 //! The tracker's world is fixed once, in units of its first guess (the holding height at its
 //! first map). [`ScaleState::metres_per_unit`] is one factor on that world about its origin (on
-//! the ground): the window multiplies camera translations, tracked points and the plane's offset
-//! by it before planting and drawing, and keeps feeding [`ScaleState::observe`] and the picks the
-//! tracker's own (unscaled) frames.
+//! the ground); [`ScaleState::observe`] and the picks always take the tracker's own (unscaled)
+//! frames. The design does not yet multiply its camera translations, tracked points and plane by
+//! it (the tree is grown in the tracker's world, whose unit is a metre to the first map's error).
 //!
-//! How a window calls it: every shown frame with a pose goes to `observe`; the height setting
-//! calls `set_holding_height_m`; in the known-length or measure tool each tap goes to
-//! [`TwoTaps::tap`], and the pair it returns, with that frame's [`scene_view`], goes to
-//! `mark_known_length` (after asking the length) or `measure`; the status line shows
-//! [`ScaleState::status`].
+//! The design's part is [`DesignScale`]: every shown frame goes to [`DesignScale::observe`]; the
+//! camera-height field sends `InputEvent::HoldingHeight`; choosing the known-length or measure
+//! tool sends `InputEvent::ScaleTool`, after which taps go to [`DesignScale::touch`] (not to the
+//! tree) and each pair of taps in one frame ([`TwoTaps`]) is measured or marked in that frame's
+//! view; the status line shows [`ScaleState::status`].
 
 use std::collections::BTreeMap;
 
@@ -502,5 +502,58 @@ mod tests {
         let mut state = ScaleState::new(1.5).expect("valid");
         assert!(state.set_holding_height_m(40.0).is_err());
         assert_eq!(state.holding_height_m(), 1.5);
+    }
+
+    #[test]
+    fn a_tool_takes_taps_but_not_drags_and_measures_in_the_frame_shown() {
+        let intrinsics = Intrinsics::from_fov(640, 480, 60f32.to_radians());
+        let camera = camera_of(&intrinsics);
+        let mut scale = DesignScale::default();
+        let ground = GroundPlane {
+            point: Vec3::ZERO,
+            normal: Vec3::Y,
+        };
+        for _ in 0..10 {
+            scale.observe(
+                &intrinsics,
+                Some(glam::DMat4::from(pose(1.5)).as_mat4()),
+                Some(ground),
+                &[],
+            );
+        }
+        scale.set_frame_index(42);
+        scale.choose(Some(ScaleTool::Measure));
+        let a = pixel(&camera, &pose(1.5), DVec3::new(-1.0, 0.0, -3.0)).as_vec2();
+        let b = pixel(&camera, &pose(1.5), DVec3::new(1.0, 0.0, -3.0)).as_vec2();
+        // A drag is no tap.
+        scale.touch(TouchPhase::Start, 1, a);
+        scale.touch(TouchPhase::End, 1, a + Vec2::new(30.0, 0.0));
+        assert_eq!(scale.taps.pending(), None);
+        for p in [a, b] {
+            scale.touch(TouchPhase::Start, 1, p);
+            scale.touch(TouchPhase::End, 1, p);
+        }
+        let measured = scale.measured.expect("measured");
+        assert!((measured.distance_m - 2.0).abs() < 1e-3, "{measured:?}");
+        assert!(
+            scale
+                .message
+                .as_deref()
+                .is_some_and(|m| m.starts_with("Distance: 2.00 m")),
+            "{:?}",
+            scale.message
+        );
+        // The known length names the footage frame it was marked in.
+        scale.choose(Some(ScaleTool::KnownLength { length_m: 1.0 }));
+        for p in [a, b] {
+            scale.touch(TouchPhase::Start, 2, p);
+            scale.touch(TouchPhase::End, 2, p);
+        }
+        assert!((scale.state.metres_per_unit() - 0.5).abs() < 1e-3);
+        assert!(
+            scale.state.status().contains("frame 42"),
+            "{}",
+            scale.state.status()
+        );
     }
 }
