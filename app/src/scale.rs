@@ -122,6 +122,11 @@ impl ScaleState {
     pub fn status(&self) -> String {
         match self.current() {
             Some(scale) => format!("Scale from {scale}"),
+            None if self.heights.num_frames() > 0 => format!(
+                "Scale: measuring the camera's height over a few frames (phone held {} m above \
+                 the ground)",
+                self.holding_height_m
+            ),
             None => format!(
                 "Scale: waiting for the ground (phone held {} m above it)",
                 self.holding_height_m
@@ -513,6 +518,21 @@ mod tests {
             point: Vec3::ZERO,
             normal: Vec3::Y,
         };
+        scale.observe(
+            &intrinsics,
+            Some(glam::DMat4::from(pose(1.5)).as_mat4()),
+            Some(ground),
+            &[],
+        );
+        // A seek shows one frame: the ground is there, its height not yet measured.
+        assert!(
+            scale
+                .state
+                .status()
+                .contains("measuring the camera's height"),
+            "{}",
+            scale.state.status()
+        );
         for _ in 0..10 {
             scale.observe(
                 &intrinsics,
