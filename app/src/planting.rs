@@ -180,6 +180,8 @@ impl DesignState {
         observations: &[Observation],
     ) {
         self.ground = ground;
+        self.scale
+            .observe(intrinsics, world_from_camera, ground, observations);
         self.occupancy
             .get_or_insert_with(|| SceneOccupancy::new(intrinsics))
             .observe(observations, world_from_camera, ground.is_some());

@@ -203,6 +203,7 @@ impl Player {
             scene.ground,
             &scene.observations,
         );
+        self.design.scale.set_frame_index(index);
         let time_s = self.footage.frames[index].time_s;
         self.advance_design(time_s, previous_time);
         Ok(())
@@ -314,6 +315,7 @@ impl Player {
             frame.scene.ground,
             &frame.scene.observations,
         );
+        self.design.scale.set_frame_index(index);
         self.image = Some(frame.rgba);
         live.shown = Some(frame.scene);
         self.last_frame_time_s = frame.time_s;

@@ -4,24 +4,31 @@
 //!
 //! The tracker's world is fixed once, in units of its first guess (the holding height at its
 //! first map). [`ScaleState::metres_per_unit`] is one factor on that world about its origin (on
-//! the ground): the window multiplies camera translations, tracked points and the plane's offset
-//! by it before planting and drawing, and keeps feeding [`ScaleState::observe`] and the picks the
-//! tracker's own (unscaled) frames.
+//! the ground); [`ScaleState::observe`] and the picks always take the tracker's own (unscaled)
+//! frames. The design does not yet multiply its camera translations, tracked points and plane by
+//! it (the tree is grown in the tracker's world, whose unit is a metre to the first map's error).
 //!
-//! How a window calls it: every shown frame with a pose goes to `observe`; the height setting
-//! calls `set_holding_height_m`; in the known-length or measure tool each tap goes to
-//! [`TwoTaps::tap`], and the pair it returns, with that frame's [`scene_view`], goes to
-//! `mark_known_length` (after asking the length) or `measure`; the status line shows
-//! [`ScaleState::status`].
+//! The design's part is [`DesignScale`]: every shown frame goes to [`DesignScale::observe`]; the
+//! camera-height field sends `InputEvent::HoldingHeight`; choosing the known-length or measure
+//! tool sends `InputEvent::ScaleTool`, after which taps go to [`DesignScale::touch`] (not to the
+//! tree) and each pair of taps in one frame ([`TwoTaps`]) is measured or marked in that frame's
+//! view; the status line shows [`ScaleState::status`].
 
-use glam::{DAffine3, DVec2, Mat4, Vec3};
+use std::collections::BTreeMap;
+
+use glam::{DAffine3, DVec2, Mat4, Vec2, Vec3};
+use serde::{Deserialize, Serialize};
+use sylva_tracking::depth_mesh::Observation;
 use sylva_tracking::measure::{FrameView, MeasureError, PixelPair, Surface};
 use sylva_tracking::scale::{
-    CameraHeights, MetricScale, ScaleError, scale_from_known_length, validate_holding_height_m,
+    CameraHeights, DEFAULT_HOLDING_HEIGHT_M, MetricScale, ScaleError, scale_from_known_length,
+    validate_holding_height_m,
 };
 use sylva_tracking::{Camera, Plane, TrackedPoint};
 
+use crate::render::{GroundPlane, Intrinsics};
 use crate::scene_tracking::SceneFrame;
+use crate::state::TouchPhase;
 
 /// The scale of the window's world.
 #[derive(Clone, Debug, PartialEq)]
@@ -115,6 +122,11 @@ impl ScaleState {
     pub fn status(&self) -> String {
         match self.current() {
             Some(scale) => format!("Scale from {scale}"),
+            None if self.heights.num_frames() > 0 => format!(
+                "Scale: measuring the camera's height over a few frames (phone held {} m above \
+                 the ground)",
+                self.holding_height_m
+            ),
             None => format!(
                 "Scale: waiting for the ground (phone held {} m above it)",
                 self.holding_height_m
@@ -160,25 +172,10 @@ impl TwoTaps {
 
 /// The tracked points of a scene frame in its world (from the ideal pixels and depths it keeps).
 pub fn scene_points(scene: &SceneFrame, camera: &Camera) -> Vec<TrackedPoint> {
-    let Some(world_from_camera) = scene.world_from_camera else {
-        return Vec::new();
-    };
-    scene
-        .observations
-        .iter()
-        .map(|o| {
-            let in_camera = Vec3::new(
-                (o.pixel.x - camera.cx as f32) / camera.fx as f32 * o.depth_m,
-                (o.pixel.y - camera.cy as f32) / camera.fy as f32 * o.depth_m,
-                o.depth_m,
-            );
-            TrackedPoint {
-                id: o.id,
-                pixel: o.pixel,
-                world: world_from_camera.transform_point3(in_camera),
-            }
-        })
-        .collect()
+    match scene.world_from_camera {
+        Some(world_from_camera) => tracked_points(&scene.observations, world_from_camera, camera),
+        None => Vec::new(),
+    }
 }
 
 /// A scene frame's pose and plane as the picks want them (None without a pose).
@@ -207,6 +204,227 @@ pub fn scene_view<'a>(
         plane,
         points,
     })
+}
+
+/// The scale tools: while one is chosen, taps on the image go to it instead of the tree.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(tag = "tool", rename_all = "snake_case")]
+pub enum ScaleTool {
+    /// Two taps: the distance between their points, in metres.
+    Measure,
+    /// Two taps on the ends of something `length_m` long: the scale from it.
+    KnownLength { length_m: f64 },
+}
+
+/// The frame shown, as the tools pick in it (the tracker's world).
+#[derive(Clone, Debug)]
+struct ShownFrame {
+    world_from_camera: DAffine3,
+    plane: Option<Plane>,
+    points: Vec<TrackedPoint>,
+}
+
+/// The design's scale: the state fed by every shown frame, the chosen tool, its taps, and what
+/// the last pair of taps gave.
+#[derive(Clone, Debug)]
+pub struct DesignScale {
+    pub state: ScaleState,
+    pub tool: Option<ScaleTool>,
+    taps: TwoTaps,
+    /// Where each touch started, to tell taps from drags.
+    touch_starts: BTreeMap<u64, Vec2>,
+    camera: Option<Camera>,
+    shown: Option<ShownFrame>,
+    /// Frames shown so far (both taps of a pair must be in one).
+    num_shown: usize,
+    /// The footage index of the frame shown, when the caller says it (messages name it).
+    frame_index: Option<usize>,
+    /// The last distance measured.
+    pub measured: Option<Measured>,
+    /// What the tool said last: a distance, a scale, or why it could not.
+    pub message: Option<String>,
+}
+
+impl Default for DesignScale {
+    fn default() -> Self {
+        Self {
+            state: ScaleState {
+                holding_height_m: DEFAULT_HOLDING_HEIGHT_M,
+                heights: CameraHeights::default(),
+                known: None,
+            },
+            tool: None,
+            taps: TwoTaps::default(),
+            touch_starts: BTreeMap::new(),
+            camera: None,
+            shown: None,
+            num_shown: 0,
+            frame_index: None,
+            measured: None,
+            message: None,
+        }
+    }
+}
+
+/// A tap moves less than this, pixels.
+const TAP_SLOP_PX: f32 = 8.0;
+
+impl DesignScale {
+    /// The frame about to be shown (the same inputs as the scene's occupancy).
+    pub fn observe(
+        &mut self,
+        intrinsics: &Intrinsics,
+        world_from_camera: Option<Mat4>,
+        ground: Option<GroundPlane>,
+        observations: &[Observation],
+    ) {
+        self.num_shown += 1;
+        self.frame_index = None;
+        let camera = *self.camera.get_or_insert_with(|| camera_of(intrinsics));
+        let Some(pose) = world_from_camera else {
+            self.shown = None;
+            return;
+        };
+        let world_from_camera = DAffine3::from_mat4(pose.as_dmat4());
+        let plane = ground.map(|g| Plane {
+            normal: g.normal.as_dvec3(),
+            offset: g.normal.dot(g.point) as f64,
+        });
+        if let Some(plane) = &plane {
+            self.state.observe(&world_from_camera, plane);
+        }
+        self.shown = Some(ShownFrame {
+            world_from_camera,
+            plane,
+            points: tracked_points(observations, pose, &camera),
+        });
+    }
+
+    /// The footage index of the frame just observed (for the messages; call after
+    /// [`Self::observe`]).
+    pub fn set_frame_index(&mut self, index: usize) {
+        self.frame_index = Some(index);
+    }
+
+    /// The camera-height field: refused (kept as it was) outside the range the field offers.
+    pub fn set_holding_height_m(&mut self, holding_height_m: f64) {
+        if let Err(e) = self.state.set_holding_height_m(holding_height_m) {
+            self.message = Some(e.to_string());
+        }
+    }
+
+    /// Chooses a tool (none: taps edit the tree again); a pending first tap is dropped.
+    pub fn choose(&mut self, tool: Option<ScaleTool>) {
+        self.tool = tool;
+        self.taps = TwoTaps::default();
+        self.touch_starts.clear();
+        self.message = match tool {
+            Some(ScaleTool::Measure) => Some("Measure: tap two points".into()),
+            Some(ScaleTool::KnownLength { length_m }) => Some(format!(
+                "Known length: tap the two ends of the {length_m:.2} m"
+            )),
+            None => None,
+        };
+    }
+
+    /// A touch while a tool is chosen; a tap (a touch that did not move) is one of the pair.
+    pub fn touch(&mut self, phase: TouchPhase, id: u64, pixel: Vec2) {
+        match phase {
+            TouchPhase::Start => {
+                self.touch_starts.insert(id, pixel);
+            }
+            TouchPhase::Move => {}
+            TouchPhase::End => {
+                if let Some(start) = self.touch_starts.remove(&id)
+                    && start.distance(pixel) <= TAP_SLOP_PX
+                {
+                    self.tap(pixel);
+                }
+            }
+        }
+    }
+
+    /// The first tap waits for the second in the same frame; the second measures or marks.
+    fn tap(&mut self, pixel: Vec2) {
+        let Some(tool) = self.tool else {
+            return;
+        };
+        let Some(pair) = self.taps.tap(self.num_shown, pixel.as_dvec2()) else {
+            self.message = Some("First point marked: tap the second in this frame".into());
+            return;
+        };
+        let pair = PixelPair {
+            frame: self.frame_index.unwrap_or(pair.frame),
+            ..pair
+        };
+        let (Some(camera), Some(shown)) = (self.camera.as_ref(), self.shown.as_ref()) else {
+            self.message = Some("No tracked frame to pick in yet".into());
+            return;
+        };
+        let view = FrameView {
+            frame: pair.frame,
+            camera,
+            world_from_camera: shown.world_from_camera,
+            plane: shown.plane,
+            points: &shown.points,
+        };
+        self.message = Some(match tool {
+            ScaleTool::Measure => match self.state.measure(&view, &pair) {
+                Ok(measured) => {
+                    self.measured = Some(measured);
+                    format!(
+                        "Distance: {:.2} m ± {:.2} m",
+                        measured.distance_m, measured.sigma_m
+                    )
+                }
+                Err(e) => format!("Cannot measure: {e}"),
+            },
+            ScaleTool::KnownLength { length_m } => {
+                match self.state.mark_known_length(&view, &pair, length_m) {
+                    Ok(_) => format!("Known length of {length_m:.2} m marked"),
+                    Err(e) => format!("Known length not taken: {e}"),
+                }
+            }
+        });
+    }
+}
+
+/// The tracking camera of the footage's intrinsics (the pixels the touches are in).
+fn camera_of(k: &Intrinsics) -> Camera {
+    Camera {
+        distortion: k.distortion.map(f64::from),
+        ..Camera::pinhole(
+            k.width,
+            k.height,
+            k.fx as f64,
+            k.fy as f64,
+            k.cx as f64,
+            k.cy as f64,
+        )
+    }
+}
+
+/// Tracked points in the world from their ideal pixels and depths seen from `world_from_camera`.
+fn tracked_points(
+    observations: &[Observation],
+    world_from_camera: Mat4,
+    camera: &Camera,
+) -> Vec<TrackedPoint> {
+    observations
+        .iter()
+        .map(|o| {
+            let in_camera = Vec3::new(
+                (o.pixel.x - camera.cx as f32) / camera.fx as f32 * o.depth_m,
+                (o.pixel.y - camera.cy as f32) / camera.fy as f32 * o.depth_m,
+                o.depth_m,
+            );
+            TrackedPoint {
+                id: o.id,
+                pixel: o.pixel,
+                world: world_from_camera.transform_point3(in_camera),
+            }
+        })
+        .collect()
 }
 
 #[cfg(test)]
@@ -289,5 +507,73 @@ mod tests {
         let mut state = ScaleState::new(1.5).expect("valid");
         assert!(state.set_holding_height_m(40.0).is_err());
         assert_eq!(state.holding_height_m(), 1.5);
+    }
+
+    #[test]
+    fn a_tool_takes_taps_but_not_drags_and_measures_in_the_frame_shown() {
+        let intrinsics = Intrinsics::from_fov(640, 480, 60f32.to_radians());
+        let camera = camera_of(&intrinsics);
+        let mut scale = DesignScale::default();
+        let ground = GroundPlane {
+            point: Vec3::ZERO,
+            normal: Vec3::Y,
+        };
+        scale.observe(
+            &intrinsics,
+            Some(glam::DMat4::from(pose(1.5)).as_mat4()),
+            Some(ground),
+            &[],
+        );
+        // A seek shows one frame: the ground is there, its height not yet measured.
+        assert!(
+            scale
+                .state
+                .status()
+                .contains("measuring the camera's height"),
+            "{}",
+            scale.state.status()
+        );
+        for _ in 0..10 {
+            scale.observe(
+                &intrinsics,
+                Some(glam::DMat4::from(pose(1.5)).as_mat4()),
+                Some(ground),
+                &[],
+            );
+        }
+        scale.set_frame_index(42);
+        scale.choose(Some(ScaleTool::Measure));
+        let a = pixel(&camera, &pose(1.5), DVec3::new(-1.0, 0.0, -3.0)).as_vec2();
+        let b = pixel(&camera, &pose(1.5), DVec3::new(1.0, 0.0, -3.0)).as_vec2();
+        // A drag is no tap.
+        scale.touch(TouchPhase::Start, 1, a);
+        scale.touch(TouchPhase::End, 1, a + Vec2::new(30.0, 0.0));
+        assert_eq!(scale.taps.pending(), None);
+        for p in [a, b] {
+            scale.touch(TouchPhase::Start, 1, p);
+            scale.touch(TouchPhase::End, 1, p);
+        }
+        let measured = scale.measured.expect("measured");
+        assert!((measured.distance_m - 2.0).abs() < 1e-3, "{measured:?}");
+        assert!(
+            scale
+                .message
+                .as_deref()
+                .is_some_and(|m| m.starts_with("Distance: 2.00 m")),
+            "{:?}",
+            scale.message
+        );
+        // The known length names the footage frame it was marked in.
+        scale.choose(Some(ScaleTool::KnownLength { length_m: 1.0 }));
+        for p in [a, b] {
+            scale.touch(TouchPhase::Start, 2, p);
+            scale.touch(TouchPhase::End, 2, p);
+        }
+        assert!((scale.state.metres_per_unit() - 0.5).abs() < 1e-3);
+        assert!(
+            scale.state.status().contains("frame 42"),
+            "{}",
+            scale.state.status()
+        );
     }
 }

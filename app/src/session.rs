@@ -201,6 +201,19 @@ impl Session {
                 InputEvent::Touch { x, y, .. } if !(x.is_finite() && y.is_finite()) => {
                     Some(format!("touch at ({x}, {y})"))
                 }
+                InputEvent::HoldingHeight { holding_height_m }
+                    if sylva_tracking::scale::validate_holding_height_m(*holding_height_m)
+                        .is_err() =>
+                {
+                    Some(format!(
+                        "a camera height of {holding_height_m} m (0.3 to 3 m)"
+                    ))
+                }
+                InputEvent::ScaleTool {
+                    tool: Some(crate::scale::ScaleTool::KnownLength { length_m }),
+                } if !(length_m.is_finite() && (0.01..=1000.0).contains(length_m)) => {
+                    Some(format!("a known length of {length_m} m"))
+                }
                 _ if !timed.time_s.is_finite() => Some("a non-finite time".into()),
                 _ => None,
             };
@@ -315,6 +328,7 @@ pub fn replay(
             record.ground_plane(),
             &record.observations(),
         );
+        state.scale.set_frame_index(index);
         state.advance_frame(camera, record.time_s, dt);
         on_frame(step, &state);
         let Some((gpu, renderer, target)) = gpu_parts.as_mut() else {

@@ -26,6 +26,7 @@ use sylva_core::{NodeId, Tree};
 
 use crate::planting::{SceneChoice, growth_scene, tree_scene};
 use crate::render::{GroundPlane, ViewCamera};
+use crate::scale::{DesignScale, ScaleTool};
 use crate::scene_tracking::SceneOccupancy;
 
 /// Growth and brush parameters the UI exposes.
@@ -220,6 +221,14 @@ pub enum InputEvent {
     Grow {
         iterations: i32,
     },
+    /// The camera-height field: how high the phone is held above the ground, metres.
+    HoldingHeight {
+        holding_height_m: f64,
+    },
+    /// Chooses a scale tool (none: taps edit the tree again).
+    ScaleTool {
+        tool: Option<ScaleTool>,
+    },
 }
 
 /// A brush stroke.
@@ -288,6 +297,8 @@ pub struct DesignState {
     pub(crate) moving_base: Option<u64>,
     /// The occupancy of the tracked scene (from the first frame with tracked points).
     pub(crate) occupancy: Option<SceneOccupancy>,
+    /// The metric scale, its tools and what they measured.
+    pub scale: DesignScale,
     pub time_s: f64,
     /// Bumped whenever the tree changes (the renderer re-meshes on change).
     pub revision: u64,
@@ -363,6 +374,7 @@ impl DesignState {
             world_from_tree: None,
             moving_base: None,
             occupancy: None,
+            scale: DesignScale::default(),
             time_s: 0.0,
             revision: 0,
             grow_debt: 0.0,
@@ -445,6 +457,10 @@ impl DesignState {
                 }
             }
             InputEvent::Grow { iterations } => self.grow_whole_tree(*iterations),
+            InputEvent::HoldingHeight { holding_height_m } => {
+                self.scale.set_holding_height_m(*holding_height_m)
+            }
+            InputEvent::ScaleTool { tool } => self.scale.choose(*tool),
         }
     }
 
@@ -557,6 +573,11 @@ impl DesignState {
     }
 
     fn touch(&mut self, phase: TouchPhase, id: u64, pixel: Vec2) {
+        if self.scale.tool.is_some() {
+            // A scale tool takes the taps (its touches never reach the tree).
+            self.scale.touch(phase, id, pixel);
+            return;
+        }
         match phase {
             TouchPhase::Start => {
                 self.touches.insert(

@@ -8,6 +8,7 @@
 
 pub mod orbit;
 pub mod plain;
+pub mod scale_ui;
 pub mod touch;
 pub mod widgets;
 
@@ -23,6 +24,8 @@ pub enum Tab {
     Tree,
     /// The research parameters with their symbols ([`plain::advanced_ui`]).
     Advanced,
+    /// The metric scale: camera height, known length and the measure tool ([`scale_ui::scale_ui`]).
+    Scale,
     Export,
 }
 
@@ -56,6 +59,8 @@ pub struct UiState {
     pub orbit_view: bool,
     pub export_requested: bool,
     pub species_names: Vec<String>,
+    /// The length the "Known length" tool marks, metres.
+    pub known_length_m: f64,
 }
 
 impl Default for UiState {
@@ -74,6 +79,7 @@ impl Default for UiState {
             orbit_view: false,
             export_requested: false,
             species_names: crate::state::species_names(),
+            known_length_m: 1.0,
         }
     }
 }
@@ -92,6 +98,7 @@ pub fn sylva_ui(
             for (tab, name) in [
                 (Tab::Tree, "Tree"),
                 (Tab::Advanced, "Advanced"),
+                (Tab::Scale, "Scale"),
                 (Tab::Export, "Export"),
             ] {
                 // Tapping the open tab closes it.
@@ -110,6 +117,7 @@ pub fn sylva_ui(
         match tab {
             Tab::Tree => plain::tree_ui(ui, &mut params, &state.species_names),
             Tab::Advanced => plain::advanced_ui(ui, &mut params),
+            Tab::Scale => scale_ui::scale_ui(ui, &mut state.known_length_m, design, events),
             Tab::Export => {
                 if ui.button("Export tree (.glb, .json)").clicked() {
                     state.export_requested = true;
@@ -128,6 +136,8 @@ pub fn sylva_ui(
     }
     let view = ui.available_rect_before_wrap();
     overlays_ui(ui, state, view);
+    scale_ui::overlay_ui(ui, design, view);
+    scale_ui::status_line_ui(ui, design, view);
     view
 }
 
