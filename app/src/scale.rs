@@ -123,8 +123,7 @@ impl ScaleState {
         match self.current() {
             Some(scale) => format!("Scale from {scale}"),
             None if self.heights.num_frames() > 0 => format!(
-                "Scale: measuring the camera's height over a few frames (phone held {} m above \
-                 the ground)",
+                "Scale: measuring the camera's height (held {} m up)",
                 self.holding_height_m
             ),
             None => format!(

@@ -3,6 +3,8 @@
 //! tree, seen as tracked points (pixel and depth) by one camera, exactly what the app's
 //! occupancy map is built from.
 
+mod ui_harness;
+
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use glam::{Vec2, Vec3};
@@ -10,15 +12,11 @@ use sylva_app::planting::SceneChoice;
 use sylva_app::render::{GroundPlane, Intrinsics, ViewCamera};
 use sylva_app::scene_tracking::{SCENE_LATENCY_FRAMES, SceneOccupancy};
 use sylva_app::state::{DesignState, InputEvent, Parameters};
-use sylva_app::ui::{UiState, sylva_ui};
+use sylva_app::ui::UiState;
 use sylva_tracking::depth_mesh::Observation;
+use ui_harness::App;
 
 const WALL_Z_M: f32 = -0.35;
-
-struct App {
-    ui: UiState,
-    design: DesignState,
-}
 
 fn camera() -> ViewCamera {
     let k = Intrinsics::from_fov(640, 480, 1.0);
@@ -79,19 +77,7 @@ fn app() -> App {
 }
 
 fn harness(app: App) -> Harness<'static, App> {
-    let mut harness = Harness::new_ui_state(
-        |ui, app: &mut App| {
-            let mut events = Vec::new();
-            sylva_ui(ui, &mut app.ui, &app.design, &mut events);
-            for e in events {
-                app.design.apply(&e);
-            }
-        },
-        app,
-    );
-    harness.set_size(egui::vec2(1100.0, 700.0));
-    harness.run();
-    harness
+    ui_harness::harness(app, 1100.0, 700.0)
 }
 
 /// Internodes reaching more than 10 cm (two voxels) into the wall where the camera saw it (the

@@ -2,18 +2,16 @@
 //! mid-stroke, undo, and the plain-language controls (issue 20), each changing the grown tree as
 //! its label says.
 
+mod ui_harness;
+
 use egui_kittest::Harness;
 use egui_kittest::kittest::Queryable;
 use glam::Vec3;
 use sylva_app::render::{Intrinsics, ViewCamera};
 use sylva_app::state::{DesignState, InputEvent, Parameters, TouchPhase};
-use sylva_app::ui::{UiState, sylva_ui};
+use sylva_app::ui::UiState;
 use sylva_core::Tree;
-
-struct App {
-    ui: UiState,
-    design: DesignState,
-}
+use ui_harness::App;
 
 fn camera() -> ViewCamera {
     let k = Intrinsics::from_fov(640, 480, 1.0);
@@ -33,19 +31,7 @@ fn app() -> App {
 }
 
 fn harness(app: App) -> Harness<'static, App> {
-    let mut harness = Harness::new_ui_state(
-        |ui, app: &mut App| {
-            let mut events = Vec::new();
-            sylva_ui(ui, &mut app.ui, &app.design, &mut events);
-            for e in events {
-                app.design.apply(&e);
-            }
-        },
-        app,
-    );
-    harness.set_size(egui::vec2(1100.0, 700.0));
-    harness.run();
-    harness
+    ui_harness::harness(app, 1100.0, 700.0)
 }
 
 fn touch(design: &mut DesignState, phase: TouchPhase, x: f32, y: f32) {
