@@ -13,13 +13,8 @@ use sylva_core::garden::{RIPLEY_RADIUS_M, ripley_excess};
 #[path = "../benches/common/garden_stands.rs"]
 mod garden_stands;
 use garden_stands::stand;
-
-fn digest(bytes: &[u8]) -> String {
-    let hash = bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {
-        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
-    });
-    format!("{hash:016x}")
-}
+#[path = "../benches/common/digest.rs"]
+mod digest;
 
 fn main() {
     let max: usize = std::env::args()
@@ -58,7 +53,7 @@ fn main() {
                 garden.mean_crown_offset_m(),
                 ripley_excess(&bases, lo, hi, RIPLEY_RADIUS_M),
                 ripley_excess(&centres, lo, hi, RIPLEY_RADIUS_M),
-                digest(&garden.to_json_bytes())
+                digest::fnv1a_hex(&garden.to_json_bytes())
             );
         }
     }

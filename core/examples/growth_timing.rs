@@ -13,6 +13,8 @@ use std::time::Instant;
 mod growth_trees;
 use growth_trees::{brush_iteration, brush_points, grow_to_with, next_brush_tree};
 
+#[path = "../benches/common/digest.rs"]
+mod digest;
 #[path = "../benches/common/thread_cpu.rs"]
 mod thread_cpu;
 use thread_cpu::thread_cpu_ns;
@@ -26,11 +28,7 @@ fn cpu_ms(start: Option<u64>) -> f64 {
 
 /// FNV-1a (64 bit) of the tree's saved JSON.
 fn digest(tree: &sylva_core::Tree) -> String {
-    let bytes = tree.to_json_bytes().expect("tree serializes");
-    let hash = bytes.iter().fold(0xcbf2_9ce4_8422_2325u64, |h, &b| {
-        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
-    });
-    format!("{hash:016x}")
+    digest::fnv1a_hex(&tree.to_json_bytes().expect("tree serializes"))
 }
 
 fn main() {

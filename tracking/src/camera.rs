@@ -299,17 +299,7 @@ mod tests {
         assert!(err.to_string().contains("frame_rate_hz"), "{err}");
     }
 
-    /// Cases per property: 2000, or `PROPTEST_CASES` (the README's long fuzzing run).
-    fn config() -> ProptestConfig {
-        let cases = std::env::var("PROPTEST_CASES")
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(2000);
-        ProptestConfig {
-            cases,
-            ..Default::default()
-        }
-    }
+    use crate::fuzz_config as config;
 
     /// What every accepted camera must satisfy.
     fn check(text: &str) {

@@ -55,3 +55,17 @@ pub use tracker::{Tracker, TrackerConfig, TrackerError};
 
 pub mod depth_mesh;
 pub mod occupancy;
+
+/// Cases per fuzzed property in the readers' unit tests: 2000, or `PROPTEST_CASES` (the README's
+/// long fuzzing run).
+#[cfg(test)]
+pub(crate) fn fuzz_config() -> proptest::prelude::ProptestConfig {
+    let cases = std::env::var("PROPTEST_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(2000);
+    proptest::prelude::ProptestConfig {
+        cases,
+        ..Default::default()
+    }
+}

@@ -493,17 +493,7 @@ mod tests {
     use proptest::collection::vec;
     use proptest::prelude::*;
 
-    /// Cases per property: 2000, or `PROPTEST_CASES` (the README's long fuzzing run).
-    fn config() -> ProptestConfig {
-        let cases = std::env::var("PROPTEST_CASES")
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(2000);
-        ProptestConfig {
-            cases,
-            ..ProptestConfig::default()
-        }
-    }
+    use crate::fuzz_config as config;
 
     /// Words a damaged list could hold: numbers of every kind, names, comments.
     fn word() -> impl Strategy<Value = String> {
