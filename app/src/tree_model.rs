@@ -1,14 +1,14 @@
 //! The tree the app shows and edits, and the meshes drawn for it: `sylva_core`'s growth and
-//! `sylva_core::geometry` meshes (finest level of detail, per-vertex ambient light from the
-//! growth shadow grid), converted to the renderer's vertices.
+//! `sylva_core::geometry` meshes (every level of detail, per-vertex ambient light from the
+//! growth shadow grid), converted to the renderer's bark vertices and leaf-card instances.
 
 use glam::Vec3;
 use sylva_core::geometry::{
-    Levels, Mesher, Season, TreeMeshes, TreeShade, build_tree_level, mesh_params_in,
+    Levels, Mesher, Season, TreeMesh as CoreMesh, TreeMeshes, TreeShade, mesh_params_in,
 };
 use sylva_core::{Skeleton, Tree};
 
-use crate::render::{LitMesh, LitVertex, TreeMesh};
+use crate::render::{CardInstance, LitMesh, LitVertex, TreeLevel, TreeLook, TreeMesh};
 use crate::state::species_named;
 
 /// Seed of the tree in the golden images.
@@ -58,10 +58,9 @@ pub fn trunk_point(skeleton: &Skeleton, h: f32) -> Vec3 {
     }
 }
 
-/// The mesh drawn for a tree: bark and alpha-cut leaves of the finest level of detail (only
-/// that level is built).
+/// The mesh drawn for a tree in summer: bark and leaf cards at every level of detail.
 pub fn mesh_of(tree: &Tree) -> TreeMesh {
-    draw_mesh(&build_tree_level(tree, 0))
+    TreeMesher::default().mesh(tree).clone()
 }
 
 /// Re-meshes the tree after every edit with the same working memory: the mesher's scratch, the
@@ -71,18 +70,17 @@ pub fn mesh_of(tree: &Tree) -> TreeMesh {
 pub struct TreeMesher {
     mesher: Mesher,
     meshes: TreeMeshes,
-    /// The leaf cards expanded into single leaves, which the leaf shader draws.
-    leaves: sylva_core::geometry::TreeMesh,
     mesh: TreeMesh,
 }
 
 impl TreeMesher {
-    /// The drawn mesh of `tree` (level 0 and leaves), as [`mesh_of`] builds it.
+    /// The drawn mesh of `tree` in summer, as [`mesh_of`] builds it.
     pub fn mesh(&mut self, tree: &Tree) -> &TreeMesh {
         self.mesh_in(tree, Season::Summer)
     }
 
-    /// The drawn mesh of `tree` in `season` (a deciduous tree has no leaves in winter).
+    /// The drawn mesh of `tree` in `season` (a deciduous tree has no leaves in winter), every
+    /// level of detail, so the renderer can pick one by the tree's size on screen.
     pub fn mesh_in(&mut self, tree: &Tree, season: Season) -> &TreeMesh {
         let params = mesh_params_in(&tree.species, season);
         let shade = TreeShade::in_season(tree, season);
@@ -90,20 +88,10 @@ impl TreeMesher {
             &tree.skeleton,
             &params,
             &|p| shade.at(p),
-            Levels::One(0),
+            Levels::All,
             &mut self.meshes,
         );
-        match self.meshes.lods.first() {
-            Some(lod) => lit_into(&lod.branches, |uv| uv, &mut self.mesh.branches),
-            None => self.mesh.branches = LitMesh::default(),
-        }
-        let cards = &self.meshes.leaves;
-        self.meshes
-            .leaf_card
-            .expand_into(cards, cards.indices.len(), &mut self.leaves);
-        lit_into(&self.leaves, leaf_uv, &mut self.mesh.leaves);
-        self.mesh.bark_color = self.meshes.colors.bark;
-        self.mesh.leaf_color = self.meshes.colors.leaf;
+        draw_mesh_into(&self.meshes, &mut self.mesh);
         &self.mesh
     }
 
@@ -113,55 +101,63 @@ impl TreeMesher {
     }
 }
 
-/// Leaf texture coordinates from the core's to the renderer's (see [`draw_mesh`]).
-fn leaf_uv([u, v]: [f32; 2]) -> [f32; 2] {
-    [u - 0.5, 1.0 - v]
-}
-
-/// The renderer's mesh of `sylva_core` meshes (level 0). Leaf texture coordinates go from
-/// the core's (u across 0..1, v from tip 0 to petiole 1) to the renderer's (x across −½..½,
-/// y from petiole 0 to tip 1).
+/// The renderer's mesh of `sylva_core` meshes: each level's bark, and its leaf cards as
+/// instances of the species' card.
 pub fn draw_mesh(meshes: &TreeMeshes) -> TreeMesh {
-    let branches = meshes
-        .lods
-        .first()
-        .map(|lod| lit(&lod.branches, |uv| uv))
-        .unwrap_or_default();
-    // The leaf shader draws one blade per quad: the cards expanded into their leaves.
-    let mut single_leaves = sylva_core::geometry::TreeMesh::default();
-    meshes.leaf_card.expand_into(
-        &meshes.leaves,
-        meshes.leaves.indices.len(),
-        &mut single_leaves,
-    );
-    let leaves = lit(&single_leaves, leaf_uv);
-    TreeMesh {
-        branches,
-        leaves,
-        bark_color: meshes.colors.bark,
-        leaf_color: meshes.colors.leaf,
-    }
+    let mut mesh = TreeMesh::default();
+    draw_mesh_into(meshes, &mut mesh);
+    mesh
 }
 
-fn lit(mesh: &sylva_core::geometry::TreeMesh, uv_of: impl Fn([f32; 2]) -> [f32; 2]) -> LitMesh {
-    let mut out = LitMesh::default();
-    lit_into(mesh, uv_of, &mut out);
-    out
+/// [`draw_mesh`] into `out`, reusing its buffers.
+fn draw_mesh_into(meshes: &TreeMeshes, out: &mut TreeMesh) {
+    out.levels
+        .resize_with(meshes.lods.len(), TreeLevel::default);
+    for (lod, level) in meshes.lods.iter().zip(&mut out.levels) {
+        lit_into(&lod.branches, &mut level.branches);
+        cards_into(
+            lod.leaves_in(&meshes.leaves),
+            lod.num_leaf_indices,
+            &mut level.cards,
+        );
+    }
+    let colors = &meshes.colors;
+    out.look = TreeLook {
+        leaf_shape: colors.leaf_shape,
+        leaf_color: colors.leaf,
+        bark_kind: colors.bark_kind,
+        bark_color: colors.bark,
+        leaf_card: meshes.leaf_card.clone(),
+    };
+}
+
+/// The cards of the first `num_indices` indices of `cards` (quads of 4 vertices and 6 indices,
+/// each card's vertices stored in order: base-left, base-right, tip-left, tip-right), into `out`.
+fn cards_into(cards: &CoreMesh, num_indices: usize, out: &mut Vec<CardInstance>) {
+    out.clear();
+    let num_cards = num_indices.min(cards.indices.len()) / 6;
+    out.extend((0..num_cards).map(|card| {
+        let first = cards.indices[6 * card] as usize;
+        let corner = |k: usize| Vec3::from(cards.positions[first + k]);
+        CardInstance {
+            origin: corner(0).to_array(),
+            across: (corner(1) - corner(0)).to_array(),
+            along: (corner(2) - corner(0)).to_array(),
+            normal: cards.normals[first],
+            ambient: cards.ambient[first],
+        }
+    }));
 }
 
 /// Writes the renderer's vertices of `mesh` into `out`, reusing its buffers.
-fn lit_into(
-    mesh: &sylva_core::geometry::TreeMesh,
-    uv_of: impl Fn([f32; 2]) -> [f32; 2],
-    out: &mut LitMesh,
-) {
+fn lit_into(mesh: &CoreMesh, out: &mut LitMesh) {
     out.vertices.clear();
     out.vertices
         .extend((0..mesh.positions.len()).map(|i| LitVertex {
             position: mesh.positions[i],
             normal: mesh.normals[i],
             ambient: mesh.ambient[i],
-            uv: uv_of(mesh.uvs[i]),
+            uv: mesh.uvs[i],
         }));
     out.indices.clear();
     out.indices.extend_from_slice(&mesh.indices);

@@ -23,10 +23,7 @@ fn the_season_control_redraws_the_design_leafless_in_winter_without_touching_the
     let grown = state.tree_sha256();
     let mut mesher = TreeMesher::default();
     let summer = mesher.mesh_in(&state.tree, state.params.season).clone();
-    assert!(
-        !summer.leaves.vertices.is_empty(),
-        "a summer maple has leaves"
-    );
+    assert!(!summer.cards().is_empty(), "a summer maple has leaves");
 
     let revision = state.revision;
     state.apply(&with(&state, 6.0, Season::Winter));
@@ -34,29 +31,23 @@ fn the_season_control_redraws_the_design_leafless_in_winter_without_touching_the
     assert!(state.revision > revision, "the design is drawn anew");
     assert_eq!(state.tree_sha256(), grown, "the tree itself is unchanged");
     let winter = mesher.mesh_in(&state.tree, state.params.season).clone();
-    assert!(
-        winter.leaves.vertices.is_empty(),
-        "a winter maple is leafless"
-    );
-    assert_eq!(
-        winter.branches.vertices.len(),
-        summer.branches.vertices.len()
-    );
+    assert!(winter.cards().is_empty(), "a winter maple is leafless");
+    assert_eq!(winter.branches().len(), summer.branches().len());
 
     // The drawn colours are the species' in its season: a red-orange autumn maple.
     state.apply(&with(&state, 6.0, Season::Autumn));
     let autumn = mesher.mesh_in(&state.tree, state.params.season).clone();
-    let [r, g, b] = autumn.leaf_color;
+    let [r, g, b] = autumn.look.leaf_color;
     assert!(
         r > 3.0 * g && r > 3.0 * b,
         "autumn maple leaves {:?}",
-        autumn.leaf_color
+        autumn.look.leaf_color
     );
     assert!(
-        summer.leaf_color[1] > summer.leaf_color[0],
+        summer.look.leaf_color[1] > summer.look.leaf_color[0],
         "summer maple leaves are green"
     );
-    assert_eq!(autumn.bark_color, summer.bark_color);
+    assert_eq!(autumn.look.bark_color, summer.look.bark_color);
     state.apply(&with(&state, 6.0, Season::Winter));
 
     // Another species keeps the season.
@@ -69,10 +60,7 @@ fn the_season_control_redraws_the_design_leafless_in_winter_without_touching_the
     assert_eq!(state.params.season, Season::Winter);
     state.apply(&with(&state, 6.0, Season::Winter));
     let spruce = mesher.mesh_in(&state.tree, state.params.season);
-    assert!(
-        !spruce.leaves.vertices.is_empty(),
-        "the spruce keeps its needles"
-    );
+    assert!(!spruce.cards().is_empty(), "the spruce keeps its needles");
 }
 
 #[test]

@@ -1,10 +1,12 @@
-//! What the renderer draws, as plain CPU data: the tree (branches and leaves, lit), the scene
+//! What the renderer draws, as plain CPU data: the tree (bark and instanced leaf cards, lit, at
+//! each level of detail), the scene
 //! occluder (depth-only), and line/point overlays. World space: metres, Y up.
 
 use bytemuck::{Pod, Zeroable};
 use glam::Vec3;
+use sylva_core::geometry::{BarkKind, LeafCard, LeafShape};
 
-/// A vertex of a lit surface (branch or leaf).
+/// A vertex of a lit surface (bark).
 #[repr(C)]
 #[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
 pub struct LitVertex {
@@ -12,7 +14,7 @@ pub struct LitVertex {
     pub normal: [f32; 3],
     /// Ambient (indirect) light at this vertex in [0, 1], from the growth shadow grid.
     pub ambient: f32,
-    /// Leaf texture coordinates: x across the blade in [-0.5, 0.5], y from petiole (0) to tip (1).
+    /// Bark texture coordinates (around the branch, along it in tiles).
     pub uv: [f32; 2],
 }
 
@@ -43,38 +45,125 @@ impl LitMesh {
     }
 }
 
-/// The tree as drawn: bark and leaves, and their linear RGB (the species' look in its season).
-#[derive(Clone, Debug, PartialEq)]
-pub struct TreeMesh {
-    pub branches: LitMesh,
-    pub leaves: LitMesh,
-    pub bark_color: [f32; 3],
-    pub leaf_color: [f32; 3],
+/// One leaf card, drawn as an instance of the species' card quad: where its corners lie.
+/// Corner (a, b) of the quad, a across and b along in 0..1, is `origin + a·across + b·along`;
+/// it samples the card texture at (a, 1 − b) (the base on the bottom row, as
+/// `sylva_core::geometry::leaf_card` draws it).
+#[repr(C)]
+#[derive(Clone, Copy, Debug, Default, PartialEq, Pod, Zeroable)]
+pub struct CardInstance {
+    /// The card's base corner on its left side, world metres.
+    pub origin: [f32; 3],
+    /// From that corner across the card to the base's right corner, metres.
+    pub across: [f32; 3],
+    /// From that corner along the card to its tip's left corner, metres.
+    pub along: [f32; 3],
+    /// Unit normal of the card's front face.
+    pub normal: [f32; 3],
+    /// Ambient light of the card in [0, 1], from the growth shadow grid.
+    pub ambient: f32,
 }
 
-impl Default for TreeMesh {
-    /// No geometry, in the renderer's former fixed bark and leaf colours.
-    fn default() -> Self {
-        TreeMesh {
-            branches: LitMesh::default(),
-            leaves: LitMesh::default(),
-            bark_color: [0.30, 0.21, 0.14],
-            leaf_color: [0.16, 0.38, 0.09],
-        }
+impl CardInstance {
+    /// The four corners: base-left, base-right, tip-left, tip-right.
+    pub fn corners(&self) -> [Vec3; 4] {
+        let (o, a, b) = (
+            Vec3::from(self.origin),
+            Vec3::from(self.across),
+            Vec3::from(self.along),
+        );
+        [o, o + a, o + b, o + a + b]
     }
 }
 
-impl TreeMesh {
-    /// Bounds of branches and leaves together.
+/// One level of detail of the drawn tree: its bark and its leaf cards.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TreeLevel {
+    pub branches: LitMesh,
+    pub cards: Vec<CardInstance>,
+}
+
+impl TreeLevel {
+    /// Triangles drawn: the bark's and two per card.
+    pub fn num_triangles(&self) -> usize {
+        self.branches.indices.len() / 3 + 2 * self.cards.len()
+    }
+
+    /// Bounds of the bark and the cards' corners, `None` when empty.
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
-        match (self.branches.bounds(), self.leaves.bounds()) {
+        let cards = self
+            .cards
+            .iter()
+            .flat_map(CardInstance::corners)
+            .map(|p| (p, p))
+            .reduce(|(a0, a1), (b0, b1)| (a0.min(b0), a1.max(b1)));
+        match (self.branches.bounds(), cards) {
             (Some(a), Some(b)) => Some((a.0.min(b.0), a.1.max(b.1))),
             (a, b) => a.or(b),
         }
     }
+}
 
+/// What the species' textures are drawn from: the leaf outline, card layout and colour of the
+/// season, the bark's pattern and colour. The renderer draws the textures again only when this
+/// changes.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TreeLook {
+    pub leaf_shape: LeafShape,
+    /// Linear RGB of the leaves in the drawn season, and of the bark.
+    pub leaf_color: [f32; 3],
+    pub bark_kind: BarkKind,
+    pub bark_color: [f32; 3],
+    /// How the leaves lie on a card.
+    pub leaf_card: LeafCard,
+}
+
+impl Default for TreeLook {
+    /// A generic broadleaf in the renderer's former fixed colours.
+    fn default() -> Self {
+        TreeLook {
+            leaf_shape: LeafShape::default(),
+            leaf_color: [0.16, 0.38, 0.09],
+            bark_kind: BarkKind::default(),
+            bark_color: [0.30, 0.21, 0.14],
+            leaf_card: LeafCard::default(),
+        }
+    }
+}
+
+/// The tree as drawn: its levels of detail, finest first (the renderer draws one, by the
+/// tree's size on screen), in the species' look in its season.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TreeMesh {
+    pub levels: Vec<TreeLevel>,
+    pub look: TreeLook,
+}
+
+impl TreeMesh {
+    /// The finest level (bark and every leaf card), `None` when nothing is drawn.
+    pub fn finest(&self) -> Option<&TreeLevel> {
+        self.levels.first()
+    }
+
+    /// The finest level's bark (empty when there is none).
+    pub fn branches(&self) -> &[LitVertex] {
+        self.finest()
+            .map_or(&[], |l| l.branches.vertices.as_slice())
+    }
+
+    /// The finest level's leaf cards.
+    pub fn cards(&self) -> &[CardInstance] {
+        self.finest().map_or(&[], |l| l.cards.as_slice())
+    }
+
+    /// Bounds of the finest level: bark and leaf cards together.
+    pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
+        self.finest().and_then(TreeLevel::bounds)
+    }
+
+    /// Triangles of the finest level.
     pub fn num_triangles(&self) -> usize {
-        (self.branches.indices.len() + self.leaves.indices.len()) / 3
+        self.finest().map_or(0, TreeLevel::num_triangles)
     }
 }
 

@@ -2,22 +2,31 @@
 //!
 //! A frame is: the sun's shadow map of the tree, then one 4× MSAA pass: camera image (undistorted
 //! for display), the scene's depth mesh into depth only (so the real scene hides the tree), the
-//! ground plane (a shadow catcher over the camera image, or a lawn outside AR), bark, leaves with
-//! alpha to coverage, then debug views (depth-mesh wireframe, feature points, brush sphere). The
-//! pass resolves into the caller's target, where the UI may draw on top.
+//! ground plane (a shadow catcher over the camera image, or a lawn outside AR), bark with the
+//! species' bark texture, leaf cards, then debug views (depth-mesh wireframe, feature points,
+//! brush sphere). The pass resolves into the caller's target, where the UI may draw on top.
+//!
+//! The tree is drawn in its species' look and season ([`TreeLook`], [`textures`]): leaf cards
+//! are instances of one quad (a [`CardInstance`] each) sampling the species' card texture,
+//! alpha to coverage, lit on both faces (the sun through a blade lights its shaded face); the
+//! level of detail is picked by the cards' size on screen ([`lod`]).
 //!
 //! World space: metres, Y up, origin on the ground plane.
 
 pub mod camera;
 pub mod gpu;
+pub mod lod;
 pub mod mesh;
 pub mod offscreen;
 mod pipelines;
 pub mod resources;
+pub mod textures;
 
 pub use camera::{Intrinsics, ViewCamera};
 pub use gpu::Gpu;
-pub use mesh::{GroundPlane, LitMesh, LitVertex, OccluderMesh, TreeMesh};
+pub use mesh::{
+    CardInstance, GroundPlane, LitMesh, LitVertex, OccluderMesh, TreeLevel, TreeLook, TreeMesh,
+};
 pub use offscreen::Offscreen;
 pub use resources::Renderer;
 

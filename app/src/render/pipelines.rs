@@ -1,6 +1,6 @@
 //! The render pipelines of the scene, all from `scene.wgsl` and sharing bind group 0.
 
-use crate::render::mesh::LitVertex;
+use crate::render::mesh::{CardInstance, LitVertex};
 
 /// Depth format of the scene and of the sun's shadow map.
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
@@ -11,22 +11,37 @@ pub const SAMPLE_COUNT: u32 = 4;
 pub struct Pipelines {
     pub scene_layout: wgpu::BindGroupLayout,
     pub shadow_layout: wgpu::BindGroupLayout,
+    /// Group 1 of every pipeline: the tree's leaf card and bark textures and their sampler.
+    pub tree_layout: wgpu::BindGroupLayout,
     pub background: wgpu::RenderPipeline,
     pub occluder: wgpu::RenderPipeline,
     pub ground_shadow: wgpu::RenderPipeline,
     pub ground_lawn: wgpu::RenderPipeline,
     pub branches: wgpu::RenderPipeline,
-    pub leaves: wgpu::RenderPipeline,
+    /// Leaf cards: instances of one quad, alpha to coverage, lit on both sides.
+    pub cards: wgpu::RenderPipeline,
     pub wire: wgpu::RenderPipeline,
     pub points: wgpu::RenderPipeline,
     pub brush: wgpu::RenderPipeline,
     pub shadow_branches: wgpu::RenderPipeline,
-    pub shadow_leaves: wgpu::RenderPipeline,
+    pub shadow_cards: wgpu::RenderPipeline,
 }
 
 const LIT_ATTRIBUTES: [wgpu::VertexAttribute; 4] =
     wgpu::vertex_attr_array![0 => Float32x3, 1 => Float32x3, 2 => Float32, 3 => Float32x2];
 const POSITION_ATTRIBUTES: [wgpu::VertexAttribute; 1] = wgpu::vertex_attr_array![0 => Float32x3];
+const CARD_ATTRIBUTES: [wgpu::VertexAttribute; 5] = wgpu::vertex_attr_array![
+    0 => Float32x3, 1 => Float32x3, 2 => Float32x3, 3 => Float32x3, 4 => Float32
+];
+
+/// One [`CardInstance`] per instance; the vertex index picks the quad's corner.
+fn card_layout() -> wgpu::VertexBufferLayout<'static> {
+    wgpu::VertexBufferLayout {
+        array_stride: std::mem::size_of::<CardInstance>() as u64,
+        step_mode: wgpu::VertexStepMode::Instance,
+        attributes: &CARD_ATTRIBUTES,
+    }
+}
 
 fn lit_layout() -> wgpu::VertexBufferLayout<'static> {
     wgpu::VertexBufferLayout {
@@ -92,8 +107,9 @@ impl Pipelines {
             label: Some("sylva shadow globals"),
             entries: &[uniform_entry()],
         });
-        let scene = pipeline_layout(device, &scene_layout);
-        let shadow = pipeline_layout(device, &shadow_layout);
+        let tree_layout = tree_bind_group_layout(device);
+        let scene = pipeline_layout(device, &[&scene_layout, &tree_layout]);
+        let shadow = pipeline_layout(device, &[&shadow_layout, &tree_layout]);
         let make = |spec: Spec| make_scene_pipeline(device, &scene, &shader, color_format, spec);
 
         let background = make(Spec {
@@ -115,10 +131,12 @@ impl Pipelines {
             cull: Some(wgpu::Face::Back),
             ..Spec::opaque("branches", "vs_lit", "fs_branch")
         });
-        let leaves = make(Spec {
-            buffer: Some(lit_layout()),
+        let cards = make(Spec {
+            buffer: Some(card_layout()),
             alpha_to_coverage: true,
-            ..Spec::opaque("leaves", "vs_lit", "fs_leaf")
+            // The alpha goes to coverage only: the frame stays opaque where a leaf's edge is.
+            write_mask: wgpu::ColorWrites::COLOR,
+            ..Spec::opaque("leaf cards", "vs_card", "fs_card")
         });
         let wire = make(Spec {
             buffer: Some(position_layout(wgpu::VertexStepMode::Vertex)),
@@ -134,22 +152,31 @@ impl Pipelines {
             ..Spec::opaque("feature points", "vs_points", "fs_points")
         });
         let brush = make(Spec::opaque("brush sphere", "vs_brush", "fs_brush").blended());
-        let shadow_branches = make_shadow_pipeline(device, &shadow, &shader, None);
-        let shadow_leaves = make_shadow_pipeline(device, &shadow, &shader, Some("fs_shadow_leaf"));
+        let shadow_branches =
+            make_shadow_pipeline(device, &shadow, &shader, lit_layout(), "vs_shadow", None);
+        let shadow_cards = make_shadow_pipeline(
+            device,
+            &shadow,
+            &shader,
+            card_layout(),
+            "vs_shadow_card",
+            Some("fs_shadow_card"),
+        );
         Pipelines {
             scene_layout,
             shadow_layout,
+            tree_layout,
             background,
             occluder,
             ground_shadow,
             ground_lawn,
             branches,
-            leaves,
+            cards,
             wire,
             points,
             brush,
             shadow_branches,
-            shadow_leaves,
+            shadow_cards,
         }
     }
 }
@@ -206,10 +233,42 @@ fn scene_bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
     })
 }
 
-fn pipeline_layout(device: &wgpu::Device, layout: &wgpu::BindGroupLayout) -> wgpu::PipelineLayout {
+/// The tree's textures: leaf card (binding 0) and bark (1), both filterable, and a repeating
+/// trilinear sampler (2).
+fn tree_bind_group_layout(device: &wgpu::Device) -> wgpu::BindGroupLayout {
+    let texture = |binding| wgpu::BindGroupLayoutEntry {
+        binding,
+        visibility: wgpu::ShaderStages::FRAGMENT,
+        ty: wgpu::BindingType::Texture {
+            sample_type: wgpu::TextureSampleType::Float { filterable: true },
+            view_dimension: wgpu::TextureViewDimension::D2,
+            multisampled: false,
+        },
+        count: None,
+    };
+    device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
+        label: Some("sylva tree textures"),
+        entries: &[
+            texture(0),
+            texture(1),
+            wgpu::BindGroupLayoutEntry {
+                binding: 2,
+                visibility: wgpu::ShaderStages::FRAGMENT,
+                ty: wgpu::BindingType::Sampler(wgpu::SamplerBindingType::Filtering),
+                count: None,
+            },
+        ],
+    })
+}
+
+fn pipeline_layout(
+    device: &wgpu::Device,
+    layouts: &[&wgpu::BindGroupLayout],
+) -> wgpu::PipelineLayout {
+    let layouts: Vec<Option<&wgpu::BindGroupLayout>> = layouts.iter().map(|l| Some(*l)).collect();
     device.create_pipeline_layout(&wgpu::PipelineLayoutDescriptor {
         label: None,
-        bind_group_layouts: &[Some(layout)],
+        bind_group_layouts: &layouts,
         immediate_size: 0,
     })
 }
@@ -268,6 +327,8 @@ fn make_shadow_pipeline(
     device: &wgpu::Device,
     layout: &wgpu::PipelineLayout,
     shader: &wgpu::ShaderModule,
+    buffer: wgpu::VertexBufferLayout<'static>,
+    vs: &str,
     fs: Option<&str>,
 ) -> wgpu::RenderPipeline {
     device.create_render_pipeline(&wgpu::RenderPipelineDescriptor {
@@ -275,9 +336,9 @@ fn make_shadow_pipeline(
         layout: Some(layout),
         vertex: wgpu::VertexState {
             module: shader,
-            entry_point: Some("vs_shadow"),
+            entry_point: Some(vs),
             compilation_options: Default::default(),
-            buffers: &[Some(lit_layout())],
+            buffers: &[Some(buffer)],
         },
         primitive: Default::default(),
         depth_stencil: Some(wgpu::DepthStencilState {

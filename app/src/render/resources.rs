@@ -6,8 +6,10 @@ use glam::{Mat4, Vec3, Vec4};
 use wgpu::util::DeviceExt;
 
 use crate::render::camera::Intrinsics;
-use crate::render::mesh::{LitMesh, OccluderMesh, TreeMesh};
+use crate::render::lod::{level_for_card_px, projected_px_per_m};
+use crate::render::mesh::{CardInstance, LitMesh, OccluderMesh, TreeLook, TreeMesh};
 use crate::render::pipelines::{DEPTH_FORMAT, Pipelines, SAMPLE_COUNT};
+use crate::render::textures::{look_images, upload_mipmapped};
 use crate::render::{FrameView, Gpu, GroundStyle};
 
 /// Side of the square shadow map, texels.
@@ -31,15 +33,19 @@ struct Globals {
     image: [f32; 4],
     viewport: [f32; 4],
     misc: [f32; 4],
-    /// rgb: linear bark and leaf colours of the tree; w unused.
-    bark_color: [f32; 4],
-    leaf_color: [f32; 4],
 }
 
 struct GpuMesh {
     vertices: wgpu::Buffer,
     indices: Option<wgpu::Buffer>,
     count: u32,
+}
+
+/// One level of detail of the tree on the GPU.
+struct GpuLevel {
+    branches: Option<GpuMesh>,
+    /// Leaf card instances and their number.
+    cards: Option<(wgpu::Buffer, u32)>,
 }
 
 struct Background {
@@ -59,11 +65,17 @@ pub struct Renderer {
     has_camera_image: bool,
     scene_group: wgpu::BindGroup,
     shadow_group: wgpu::BindGroup,
-    branches: Option<GpuMesh>,
-    leaves: Option<GpuMesh>,
+    /// The tree's levels of detail, finest first, and the mean side of a finest-level leaf
+    /// card (metres; 0 without cards), by which a level is picked for the tree's size on screen.
+    levels: Vec<GpuLevel>,
+    card_side_m: f32,
+    /// The level the last frame drew.
+    drawn_level: usize,
     tree_bounds: Option<(Vec3, Vec3)>,
-    /// Linear RGB of the tree's bark and leaves.
-    tree_colors: [[f32; 3]; 2],
+    /// The look the tree's textures were drawn for, and those textures' bind group.
+    tree_look: Option<TreeLook>,
+    tree_group: wgpu::BindGroup,
+    tree_sampler: wgpu::Sampler,
     occluder: Option<GpuMesh>,
     wireframe: Option<GpuMesh>,
     points: Option<GpuMesh>,
@@ -129,6 +141,25 @@ impl Renderer {
             min_filter: wgpu::FilterMode::Linear,
             ..Default::default()
         });
+        let tree_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
+            label: Some("tree textures"),
+            address_mode_u: wgpu::AddressMode::Repeat,
+            address_mode_v: wgpu::AddressMode::Repeat,
+            mag_filter: wgpu::FilterMode::Linear,
+            min_filter: wgpu::FilterMode::Linear,
+            mipmap_filter: wgpu::MipmapFilterMode::Linear,
+            ..Default::default()
+        });
+        // Until a tree comes, 1 × 1 placeholders (nothing samples them).
+        let placeholder = image::RgbaImage::from_pixel(1, 1, image::Rgba([128, 128, 128, 255]));
+        let placeholder = upload_mipmapped(device, &gpu.queue, "no tree", &placeholder, false);
+        let tree_group = tree_group(
+            device,
+            &pipelines,
+            &placeholder,
+            &placeholder,
+            &tree_sampler,
+        );
         let background = Background {
             texture: background_texture(device, (1, 1)),
             intrinsics: Intrinsics::from_fov(1, 1, 1.0),
@@ -160,13 +191,13 @@ impl Renderer {
             has_camera_image: false,
             scene_group,
             shadow_group,
-            branches: None,
-            leaves: None,
+            levels: Vec::new(),
+            card_side_m: 0.0,
+            drawn_level: 0,
             tree_bounds: None,
-            tree_colors: {
-                let none = TreeMesh::default();
-                [none.bark_color, none.leaf_color]
-            },
+            tree_look: None,
+            tree_group,
+            tree_sampler,
             occluder: None,
             wireframe: None,
             points: None,
@@ -179,12 +210,53 @@ impl Renderer {
         self.color_format
     }
 
-    /// Uploads the tree (replacing the previous one).
+    /// Uploads the tree (replacing the previous one): every level of detail, and the species'
+    /// leaf card and bark textures when its look differs from the last tree's.
     pub fn set_tree(&mut self, gpu: &Gpu, tree: &TreeMesh) {
-        self.branches = upload_lit(&gpu.device, &tree.branches);
-        self.leaves = upload_lit(&gpu.device, &tree.leaves);
+        let device = &gpu.device;
+        self.levels = tree
+            .levels
+            .iter()
+            .map(|level| GpuLevel {
+                branches: upload_lit(device, &level.branches),
+                cards: upload(device, &level.cards, None).map(|m| (m.vertices, m.count)),
+            })
+            .collect();
+        self.card_side_m = mean_card_side_m(tree.cards());
         self.tree_bounds = tree.bounds();
-        self.tree_colors = [tree.bark_color, tree.leaf_color];
+        if self.tree_look.as_ref() != Some(&tree.look) {
+            let (card, bark) = look_images(&tree.look);
+            let card = upload_mipmapped(device, &gpu.queue, "leaf card", &card, true);
+            let bark = upload_mipmapped(device, &gpu.queue, "bark", &bark, false);
+            self.tree_group = tree_group(device, &self.pipelines, &card, &bark, &self.tree_sampler);
+            self.tree_look = Some(tree.look.clone());
+        }
+    }
+
+    /// The level of detail the last frame drew (0 = finest).
+    pub fn drawn_level(&self) -> usize {
+        self.drawn_level
+    }
+
+    /// The level of detail drawn for `view`: the finest whose leaf cards are at least
+    /// [`crate::render::lod::MIN_CARD_PX`] on screen at the tree's centre (coarser levels
+    /// merge the cards into fewer, larger ones); the finest for a tree without leaves.
+    pub fn level_for(&self, view: &FrameView, size: (u32, u32)) -> usize {
+        let region = letterbox(size, &view.camera.intrinsics);
+        let camera = view
+            .camera
+            .intrinsics
+            .scaled_to(region[2].round() as u32, region[3].round() as u32);
+        let Some((lo, hi)) = self.tree_bounds else {
+            return 0;
+        };
+        let px_per_m = projected_px_per_m(
+            camera.fy,
+            view.camera.position(),
+            view.camera.world_from_camera.z_axis.truncate(),
+            0.5 * (lo + hi),
+        );
+        level_for_card_px(self.card_side_m * px_per_m, self.levels.len())
     }
 
     /// Uploads the scene's depth mesh (occluder and wireframe).
@@ -294,6 +366,7 @@ impl Renderer {
         view: &FrameView,
     ) {
         self.ensure_targets(&gpu.device, size);
+        self.drawn_level = self.level_for(view, size);
         let region = letterbox(size, &view.camera.intrinsics);
         let globals = self.globals_for(view, region);
         gpu.queue
@@ -327,6 +400,7 @@ impl Renderer {
         });
         pass.set_viewport(region[0], region[1], region[2], region[3], 0.0, 1.0);
         pass.set_bind_group(0, &self.scene_group, &[]);
+        pass.set_bind_group(1, &self.tree_group, &[]);
         let p = &self.pipelines;
         pass.set_pipeline(&p.background);
         pass.draw(0..3, 0..1);
@@ -340,8 +414,10 @@ impl Renderer {
             });
             pass.draw(0..6, 0..1);
         }
-        draw(&mut pass, &p.branches, self.branches.as_ref());
-        draw(&mut pass, &p.leaves, self.leaves.as_ref());
+        if let Some(level) = self.levels.get(self.drawn_level) {
+            draw(&mut pass, &p.branches, level.branches.as_ref());
+            draw_cards(&mut pass, &p.cards, level.cards.as_ref());
+        }
         if view.debug.depth_wireframe {
             draw(&mut pass, &p.wire, self.wireframe.as_ref());
         }
@@ -375,16 +451,13 @@ impl Renderer {
             multiview_mask: None,
         });
         pass.set_bind_group(0, &self.shadow_group, &[]);
-        draw(
-            &mut pass,
-            &self.pipelines.shadow_branches,
-            self.branches.as_ref(),
-        );
-        draw(
-            &mut pass,
-            &self.pipelines.shadow_leaves,
-            self.leaves.as_ref(),
-        );
+        pass.set_bind_group(1, &self.tree_group, &[]);
+        let Some(level) = self.levels.get(self.drawn_level) else {
+            return;
+        };
+        let p = &self.pipelines;
+        draw(&mut pass, &p.shadow_branches, level.branches.as_ref());
+        draw_cards(&mut pass, &p.shadow_cards, level.cards.as_ref());
     }
 
     fn globals_for(&self, view: &FrameView, region: [f32; 4]) -> Globals {
@@ -437,8 +510,6 @@ impl Renderer {
             ],
             viewport: region,
             misc: [3.0, texel, 1.5, 0.0],
-            bark_color: Vec3::from(self.tree_colors[0]).extend(1.0).to_array(),
-            leaf_color: Vec3::from(self.tree_colors[1]).extend(1.0).to_array(),
         }
     }
 }
@@ -515,6 +586,63 @@ fn draw(pass: &mut wgpu::RenderPass<'_>, pipeline: &wgpu::RenderPipeline, mesh: 
         }
         None => pass.draw(0..mesh.count, 0..1),
     }
+}
+
+/// Draws card instances: one quad (6 vertices) per instance.
+fn draw_cards(
+    pass: &mut wgpu::RenderPass<'_>,
+    pipeline: &wgpu::RenderPipeline,
+    cards: Option<&(wgpu::Buffer, u32)>,
+) {
+    let Some((buffer, count)) = cards else {
+        return;
+    };
+    pass.set_pipeline(pipeline);
+    pass.set_vertex_buffer(0, buffer.slice(..));
+    pass.draw(0..6, 0..*count);
+}
+
+/// Mean side of the cards (the square root of their mean area), metres; 0 for none.
+fn mean_card_side_m(cards: &[CardInstance]) -> f32 {
+    if cards.is_empty() {
+        return 0.0;
+    }
+    let area: f32 = cards
+        .iter()
+        .map(|c| Vec3::from(c.across).cross(Vec3::from(c.along)).length())
+        .sum();
+    (area / cards.len() as f32).sqrt()
+}
+
+fn tree_group(
+    device: &wgpu::Device,
+    pipelines: &Pipelines,
+    card: &wgpu::Texture,
+    bark: &wgpu::Texture,
+    sampler: &wgpu::Sampler,
+) -> wgpu::BindGroup {
+    let (card, bark) = (
+        card.create_view(&Default::default()),
+        bark.create_view(&Default::default()),
+    );
+    device.create_bind_group(&wgpu::BindGroupDescriptor {
+        label: Some("tree textures"),
+        layout: &pipelines.tree_layout,
+        entries: &[
+            wgpu::BindGroupEntry {
+                binding: 0,
+                resource: wgpu::BindingResource::TextureView(&card),
+            },
+            wgpu::BindGroupEntry {
+                binding: 1,
+                resource: wgpu::BindingResource::TextureView(&bark),
+            },
+            wgpu::BindGroupEntry {
+                binding: 2,
+                resource: wgpu::BindingResource::Sampler(sampler),
+            },
+        ],
+    })
 }
 
 fn upload_lit(device: &wgpu::Device, mesh: &LitMesh) -> Option<GpuMesh> {

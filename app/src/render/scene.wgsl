@@ -26,9 +26,6 @@ struct Globals {
     viewport: vec4<f32>,
     // point size (px), shadow map texel size (uv), PCF spacing (texels), unused.
     misc: vec4<f32>,
-    // rgb: linear bark and leaf colours of the tree (its species in its season); w unused.
-    bark_color: vec4<f32>,
-    leaf_color: vec4<f32>,
 }
 
 @group(0) @binding(0) var<uniform> g: Globals;
@@ -36,9 +33,20 @@ struct Globals {
 @group(0) @binding(2) var shadow_sampler: sampler_comparison;
 @group(0) @binding(3) var background: texture_2d<f32>;
 @group(0) @binding(4) var linear_sampler: sampler;
+// The tree's species in its season: the leaf card (alpha outside the leaves) and the bark tile,
+// both sRGB with mipmaps, and a repeating trilinear sampler.
+@group(1) @binding(0) var card_texture: texture_2d<f32>;
+@group(1) @binding(1) var bark_texture: texture_2d<f32>;
+@group(1) @binding(2) var tree_sampler: sampler;
 
 const LAWN: vec3<f32> = vec3<f32>(0.22, 0.42, 0.16);
 const SKY: vec3<f32> = vec3<f32>(0.72, 0.82, 1.0);
+// Share of the sun a leaf blade passes to its shaded face: a thin blade transmits about as much
+// green light as it reflects, so the underside of a sunlit leaf glows rather than going black.
+const LEAF_TRANSMISSION: f32 = 0.6;
+// Least sky light on a leaf, as a share of the open sky's: deep in a crown the light that the
+// growth shadow grid takes away still reaches a blade through the leaves around it.
+const LEAF_AMBIENT_FLOOR: f32 = 0.35;
 
 // Fraction of the sun visible from a point, percentage-closer filtered over a 5 x 5 footprint
 // (each tap is itself a bilinear 2 x 2 comparison): a soft edge.
@@ -98,27 +106,71 @@ fn vs_lit(v: LitIn) -> LitOut {
 @fragment
 fn fs_branch(v: LitOut) -> @location(0) vec4<f32> {
     let n = normalize(v.normal);
-    return vec4<f32>(shade(g.bark_color.rgb, n, v.world, v.ambient), 1.0);
+    let bark = textureSample(bark_texture, tree_sampler, v.uv).rgb;
+    return vec4<f32>(shade(bark, n, v.world, v.ambient), 1.0);
 }
 
-// Leaf blade: half width 0.5 sin(pi y)^0.7 along y in [0, 1]; the signed distance to the edge,
-// divided by its screen-space derivative, becomes coverage (alpha to coverage under MSAA).
-fn leaf_coverage(uv: vec2<f32>) -> f32 {
-    let y = clamp(uv.y, 0.0, 1.0);
-    let half_width = 0.5 * pow(sin(3.14159265 * y), 0.7);
-    let d = half_width - abs(uv.x);
-    return clamp(d / max(fwidth(d), 1e-5) + 0.5, 0.0, 1.0);
+// ---- leaf cards: one quad, instanced; two-sided ----
+
+struct CardIn {
+    @location(0) origin: vec3<f32>,
+    @location(1) across: vec3<f32>,
+    @location(2) along: vec3<f32>,
+    @location(3) normal: vec3<f32>,
+    @location(4) ambient: f32,
 }
 
-@fragment
-fn fs_leaf(v: LitOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
-    let alpha = leaf_coverage(v.uv);
-    var n = normalize(v.normal);
+// Corner of the card quad for vertex `i` of its two triangles: (across, along) in 0..1.
+fn card_corner(i: u32) -> vec2<f32> {
+    var corners = array<vec2<f32>, 6>(
+        vec2<f32>(0.0, 0.0), vec2<f32>(1.0, 0.0), vec2<f32>(1.0, 1.0),
+        vec2<f32>(0.0, 0.0), vec2<f32>(1.0, 1.0), vec2<f32>(0.0, 1.0),
+    );
+    return corners[i];
+}
+
+@vertex
+fn vs_card(@builtin(vertex_index) i: u32, c: CardIn) -> LitOut {
+    let k = card_corner(i);
+    let world = c.origin + c.across * k.x + c.along * k.y;
+    var out: LitOut;
+    out.clip = g.clip_from_world * vec4<f32>(world, 1.0);
+    out.world = world;
+    out.normal = c.normal;
+    out.ambient = c.ambient;
+    // The card texture has the base on its bottom row.
+    out.uv = vec2<f32>(k.x, 1.0 - k.y);
+    return out;
+}
+
+// A leaf lit on both faces: the face seen reflects the sun when it faces it and, when the sun
+// is behind the blade, passes on the transmitted share; the shadow map is read from the side
+// facing the sun. Sky light reaches both faces.
+fn shade_leaf(albedo: vec3<f32>, normal: vec3<f32>, front: bool, world: vec3<f32>, ambient: f32) -> vec3<f32> {
+    let l = g.sun_direction.xyz;
+    var n = normalize(normal);
     if (!front) {
         n = -n;
     }
-    let tint = g.leaf_color.rgb * (0.85 + 0.3 * v.uv.y);
-    return vec4<f32>(shade(tint, n, v.world, v.ambient), alpha);
+    let n_dot_l = dot(n, l);
+    let sunward = select(-n, n, n_dot_l >= 0.0);
+    let sun = max(n_dot_l, 0.0) + LEAF_TRANSMISSION * max(-n_dot_l, 0.0);
+    let direct = sun * sun_visibility(world, sunward) * g.sun_direction.w;
+    let sky = g.sun_color.w * mix(LEAF_AMBIENT_FLOOR, 1.0, ambient) * (0.6 + 0.4 * abs(n.y));
+    return albedo * (sky * SKY + direct * g.sun_color.rgb);
+}
+
+// Alpha sharpened to the texel's screen-space footprint: a crisp blade edge under alpha to
+// coverage at any distance (the mipmaps keep the covered share).
+fn sharpened_alpha(a: f32) -> f32 {
+    return clamp((a - 0.5) / max(fwidth(a), 1e-4) + 0.5, 0.0, 1.0);
+}
+
+@fragment
+fn fs_card(v: LitOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
+    let texel = textureSample(card_texture, tree_sampler, v.uv);
+    let alpha = sharpened_alpha(texel.a);
+    return vec4<f32>(shade_leaf(texel.rgb, v.normal, front, v.world, v.ambient), alpha);
 }
 
 // ---- shadow map (depth only, from the sun) ----
@@ -136,10 +188,18 @@ fn vs_shadow(v: LitIn) -> ShadowOut {
     return out;
 }
 
+@vertex
+fn vs_shadow_card(@builtin(vertex_index) i: u32, c: CardIn) -> ShadowOut {
+    let k = card_corner(i);
+    var out: ShadowOut;
+    out.clip = g.light_clip_from_world * vec4<f32>(c.origin + c.across * k.x + c.along * k.y, 1.0);
+    out.uv = vec2<f32>(k.x, 1.0 - k.y);
+    return out;
+}
+
 @fragment
-fn fs_shadow_leaf(v: ShadowOut) {
-    let y = clamp(v.uv.y, 0.0, 1.0);
-    if (abs(v.uv.x) > 0.5 * pow(sin(3.14159265 * y), 0.7)) {
+fn fs_shadow_card(v: ShadowOut) {
+    if (textureSample(card_texture, tree_sampler, v.uv).a < 0.5) {
         discard;
     }
 }
