@@ -13,6 +13,7 @@
 //!
 //! World space: metres, Y up, origin on the ground plane.
 
+mod buffers;
 pub mod camera;
 pub mod gpu;
 pub mod lod;
@@ -21,6 +22,7 @@ pub mod offscreen;
 mod pipelines;
 pub mod resources;
 pub mod textures;
+mod tree_gpu;
 
 pub use camera::{Intrinsics, ViewCamera};
 pub use gpu::Gpu;

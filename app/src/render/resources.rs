@@ -3,13 +3,11 @@
 use bytemuck::{Pod, Zeroable};
 use glam::{Mat4, Vec3, Vec4};
 
-use wgpu::util::DeviceExt;
-
+use crate::render::buffers::{GpuMesh, draw, upload};
 use crate::render::camera::Intrinsics;
-use crate::render::lod::{level_for_card_px, projected_px_per_m};
-use crate::render::mesh::{CardInstance, LitMesh, OccluderMesh, TreeLook, TreeMesh};
+use crate::render::mesh::{OccluderMesh, TreeMesh};
 use crate::render::pipelines::{DEPTH_FORMAT, Pipelines, SAMPLE_COUNT};
-use crate::render::textures::{look_images, upload_mipmapped};
+use crate::render::tree_gpu::GpuTree;
 use crate::render::{FrameView, Gpu, GroundStyle};
 
 /// Side of the square shadow map, texels.
@@ -35,19 +33,6 @@ struct Globals {
     misc: [f32; 4],
 }
 
-struct GpuMesh {
-    vertices: wgpu::Buffer,
-    indices: Option<wgpu::Buffer>,
-    count: u32,
-}
-
-/// One level of detail of the tree on the GPU.
-struct GpuLevel {
-    branches: Option<GpuMesh>,
-    /// Leaf card instances and their number.
-    cards: Option<(wgpu::Buffer, u32)>,
-}
-
 struct Background {
     texture: wgpu::Texture,
     intrinsics: Intrinsics,
@@ -65,17 +50,9 @@ pub struct Renderer {
     has_camera_image: bool,
     scene_group: wgpu::BindGroup,
     shadow_group: wgpu::BindGroup,
-    /// The tree's levels of detail, finest first, and the mean side of a finest-level leaf
-    /// card (metres; 0 without cards), by which a level is picked for the tree's size on screen.
-    levels: Vec<GpuLevel>,
-    card_side_m: f32,
-    /// The level the last frame drew.
+    tree: GpuTree,
+    /// The level of detail the last frame drew.
     drawn_level: usize,
-    tree_bounds: Option<(Vec3, Vec3)>,
-    /// The look the tree's textures were drawn for, and those textures' bind group.
-    tree_look: Option<TreeLook>,
-    tree_group: wgpu::BindGroup,
-    tree_sampler: wgpu::Sampler,
     occluder: Option<GpuMesh>,
     wireframe: Option<GpuMesh>,
     points: Option<GpuMesh>,
@@ -141,25 +118,7 @@ impl Renderer {
             min_filter: wgpu::FilterMode::Linear,
             ..Default::default()
         });
-        let tree_sampler = device.create_sampler(&wgpu::SamplerDescriptor {
-            label: Some("tree textures"),
-            address_mode_u: wgpu::AddressMode::Repeat,
-            address_mode_v: wgpu::AddressMode::Repeat,
-            mag_filter: wgpu::FilterMode::Linear,
-            min_filter: wgpu::FilterMode::Linear,
-            mipmap_filter: wgpu::MipmapFilterMode::Linear,
-            ..Default::default()
-        });
-        // Until a tree comes, 1 × 1 placeholders (nothing samples them).
-        let placeholder = image::RgbaImage::from_pixel(1, 1, image::Rgba([128, 128, 128, 255]));
-        let placeholder = upload_mipmapped(device, &gpu.queue, "no tree", &placeholder, false);
-        let tree_group = tree_group(
-            device,
-            &pipelines,
-            &placeholder,
-            &placeholder,
-            &tree_sampler,
-        );
+        let tree = GpuTree::new(gpu, &pipelines);
         let background = Background {
             texture: background_texture(device, (1, 1)),
             intrinsics: Intrinsics::from_fov(1, 1, 1.0),
@@ -191,13 +150,8 @@ impl Renderer {
             has_camera_image: false,
             scene_group,
             shadow_group,
-            levels: Vec::new(),
-            card_side_m: 0.0,
+            tree,
             drawn_level: 0,
-            tree_bounds: None,
-            tree_look: None,
-            tree_group,
-            tree_sampler,
             occluder: None,
             wireframe: None,
             points: None,
@@ -213,24 +167,7 @@ impl Renderer {
     /// Uploads the tree (replacing the previous one): every level of detail, and the species'
     /// leaf card and bark textures when its look differs from the last tree's.
     pub fn set_tree(&mut self, gpu: &Gpu, tree: &TreeMesh) {
-        let device = &gpu.device;
-        self.levels = tree
-            .levels
-            .iter()
-            .map(|level| GpuLevel {
-                branches: upload_lit(device, &level.branches),
-                cards: upload(device, &level.cards, None).map(|m| (m.vertices, m.count)),
-            })
-            .collect();
-        self.card_side_m = mean_card_side_m(tree.cards());
-        self.tree_bounds = tree.bounds();
-        if self.tree_look.as_ref() != Some(&tree.look) {
-            let (card, bark) = look_images(&tree.look);
-            let card = upload_mipmapped(device, &gpu.queue, "leaf card", &card, true);
-            let bark = upload_mipmapped(device, &gpu.queue, "bark", &bark, false);
-            self.tree_group = tree_group(device, &self.pipelines, &card, &bark, &self.tree_sampler);
-            self.tree_look = Some(tree.look.clone());
-        }
+        self.tree.set(gpu, &self.pipelines, tree);
     }
 
     /// The level of detail the last frame drew (0 = finest).
@@ -247,16 +184,7 @@ impl Renderer {
             .camera
             .intrinsics
             .scaled_to(region[2].round() as u32, region[3].round() as u32);
-        let Some((lo, hi)) = self.tree_bounds else {
-            return 0;
-        };
-        let px_per_m = projected_px_per_m(
-            camera.fy,
-            view.camera.position(),
-            view.camera.world_from_camera.z_axis.truncate(),
-            0.5 * (lo + hi),
-        );
-        level_for_card_px(self.card_side_m * px_per_m, self.levels.len())
+        self.tree.level_for(&view.camera, camera.fy)
     }
 
     /// Uploads the scene's depth mesh (occluder and wireframe).
@@ -400,24 +328,22 @@ impl Renderer {
         });
         pass.set_viewport(region[0], region[1], region[2], region[3], 0.0, 1.0);
         pass.set_bind_group(0, &self.scene_group, &[]);
-        pass.set_bind_group(1, &self.tree_group, &[]);
+        pass.set_bind_group(1, self.tree.group(), &[]);
         let p = &self.pipelines;
         pass.set_pipeline(&p.background);
         pass.draw(0..3, 0..1);
         if view.occlude {
             draw(&mut pass, &p.occluder, self.occluder.as_ref());
         }
-        if view.ground.is_some() && self.tree_bounds.is_some() {
+        if view.ground.is_some() && self.tree.bounds().is_some() {
             pass.set_pipeline(match view.ground_style {
                 GroundStyle::ShadowCatcher => &p.ground_shadow,
                 GroundStyle::Lawn => &p.ground_lawn,
             });
             pass.draw(0..6, 0..1);
         }
-        if let Some(level) = self.levels.get(self.drawn_level) {
-            draw(&mut pass, &p.branches, level.branches.as_ref());
-            draw_cards(&mut pass, &p.cards, level.cards.as_ref());
-        }
+        self.tree
+            .draw(&mut pass, self.drawn_level, &p.branches, &p.cards);
         if view.debug.depth_wireframe {
             draw(&mut pass, &p.wire, self.wireframe.as_ref());
         }
@@ -451,13 +377,14 @@ impl Renderer {
             multiview_mask: None,
         });
         pass.set_bind_group(0, &self.shadow_group, &[]);
-        pass.set_bind_group(1, &self.tree_group, &[]);
-        let Some(level) = self.levels.get(self.drawn_level) else {
-            return;
-        };
+        pass.set_bind_group(1, self.tree.group(), &[]);
         let p = &self.pipelines;
-        draw(&mut pass, &p.shadow_branches, level.branches.as_ref());
-        draw_cards(&mut pass, &p.shadow_cards, level.cards.as_ref());
+        self.tree.draw(
+            &mut pass,
+            self.drawn_level,
+            &p.shadow_branches,
+            &p.shadow_cards,
+        );
     }
 
     fn globals_for(&self, view: &FrameView, region: [f32; 4]) -> Globals {
@@ -470,7 +397,7 @@ impl Renderer {
         };
         let light = &view.lighting;
         let sun = light.sun_direction.try_normalize().unwrap_or(Vec3::Y);
-        let (centre, radius) = match self.tree_bounds {
+        let (centre, radius) = match self.tree.bounds() {
             Some((lo, hi)) => (0.5 * (lo + hi), (0.5 * (hi - lo)).length().max(0.05)),
             None => (Vec3::ZERO, 1.0),
         };
@@ -571,109 +498,6 @@ pub fn letterbox(size: (u32, u32), k: &Intrinsics) -> [f32; 4] {
     };
     let (w, h) = (w.round().max(1.0), h.round().max(1.0));
     [((tw - w) * 0.5).round(), ((th - h) * 0.5).round(), w, h]
-}
-
-fn draw(pass: &mut wgpu::RenderPass<'_>, pipeline: &wgpu::RenderPipeline, mesh: Option<&GpuMesh>) {
-    let Some(mesh) = mesh else {
-        return;
-    };
-    pass.set_pipeline(pipeline);
-    pass.set_vertex_buffer(0, mesh.vertices.slice(..));
-    match &mesh.indices {
-        Some(indices) => {
-            pass.set_index_buffer(indices.slice(..), wgpu::IndexFormat::Uint32);
-            pass.draw_indexed(0..mesh.count, 0, 0..1);
-        }
-        None => pass.draw(0..mesh.count, 0..1),
-    }
-}
-
-/// Draws card instances: one quad (6 vertices) per instance.
-fn draw_cards(
-    pass: &mut wgpu::RenderPass<'_>,
-    pipeline: &wgpu::RenderPipeline,
-    cards: Option<&(wgpu::Buffer, u32)>,
-) {
-    let Some((buffer, count)) = cards else {
-        return;
-    };
-    pass.set_pipeline(pipeline);
-    pass.set_vertex_buffer(0, buffer.slice(..));
-    pass.draw(0..6, 0..*count);
-}
-
-/// Mean side of the cards (the square root of their mean area), metres; 0 for none.
-fn mean_card_side_m(cards: &[CardInstance]) -> f32 {
-    if cards.is_empty() {
-        return 0.0;
-    }
-    let area: f32 = cards
-        .iter()
-        .map(|c| Vec3::from(c.across).cross(Vec3::from(c.along)).length())
-        .sum();
-    (area / cards.len() as f32).sqrt()
-}
-
-fn tree_group(
-    device: &wgpu::Device,
-    pipelines: &Pipelines,
-    card: &wgpu::Texture,
-    bark: &wgpu::Texture,
-    sampler: &wgpu::Sampler,
-) -> wgpu::BindGroup {
-    let (card, bark) = (
-        card.create_view(&Default::default()),
-        bark.create_view(&Default::default()),
-    );
-    device.create_bind_group(&wgpu::BindGroupDescriptor {
-        label: Some("tree textures"),
-        layout: &pipelines.tree_layout,
-        entries: &[
-            wgpu::BindGroupEntry {
-                binding: 0,
-                resource: wgpu::BindingResource::TextureView(&card),
-            },
-            wgpu::BindGroupEntry {
-                binding: 1,
-                resource: wgpu::BindingResource::TextureView(&bark),
-            },
-            wgpu::BindGroupEntry {
-                binding: 2,
-                resource: wgpu::BindingResource::Sampler(sampler),
-            },
-        ],
-    })
-}
-
-fn upload_lit(device: &wgpu::Device, mesh: &LitMesh) -> Option<GpuMesh> {
-    upload(device, &mesh.vertices, Some(&mesh.indices))
-}
-
-fn upload<T: Pod>(
-    device: &wgpu::Device,
-    vertices: &[T],
-    indices: Option<&[u32]>,
-) -> Option<GpuMesh> {
-    if vertices.is_empty() || indices.is_some_and(|i| i.is_empty()) {
-        return None;
-    }
-    let vertex_buffer = device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-        label: None,
-        contents: bytemuck::cast_slice(vertices),
-        usage: wgpu::BufferUsages::VERTEX,
-    });
-    let index_buffer = indices.map(|indices| {
-        device.create_buffer_init(&wgpu::util::BufferInitDescriptor {
-            label: None,
-            contents: bytemuck::cast_slice(indices),
-            usage: wgpu::BufferUsages::INDEX,
-        })
-    });
-    Some(GpuMesh {
-        vertices: vertex_buffer,
-        count: indices.map_or(vertices.len(), |i| i.len()) as u32,
-        indices: index_buffer,
-    })
 }
 
 fn background_texture(device: &wgpu::Device, size: (u32, u32)) -> wgpu::Texture {
