@@ -120,6 +120,7 @@ fn draw_mesh_into(meshes: &TreeMeshes, out: &mut TreeMesh) {
             lod.num_leaf_indices,
             &mut level.cards,
         );
+        fruit_into(&meshes.fruit, lod.num_fruit_indices, &mut level.fruit);
     }
     let colors = &meshes.colors;
     out.look = TreeLook {
@@ -128,6 +129,7 @@ fn draw_mesh_into(meshes: &TreeMeshes, out: &mut TreeMesh) {
         bark_kind: colors.bark_kind,
         bark_color: colors.bark,
         leaf_card: meshes.leaf_card.clone(),
+        fruit_color: colors.fruit,
     };
 }
 
@@ -147,6 +149,22 @@ fn cards_into(cards: &CoreMesh, num_indices: usize, out: &mut Vec<CardInstance>)
             ambient: cards.ambient[first],
         }
     }));
+}
+
+/// The fruit of the first `num_indices` indices of `fruit` (stored in vertex order, so they use
+/// a prefix of its vertices), into `out`.
+fn fruit_into(fruit: &CoreMesh, num_indices: usize, out: &mut LitMesh) {
+    let num_indices = num_indices.min(fruit.indices.len());
+    let num_vertices = fruit.num_vertices_of_prefix(num_indices);
+    out.vertices.clear();
+    out.vertices.extend((0..num_vertices).map(|i| LitVertex {
+        position: fruit.positions[i],
+        normal: fruit.normals[i],
+        ambient: fruit.ambient[i],
+        uv: fruit.uvs[i],
+    }));
+    out.indices.clear();
+    out.indices.extend_from_slice(&fruit.indices[..num_indices]);
 }
 
 /// Writes the renderer's vertices of `mesh` into `out`, reusing its buffers.

@@ -420,6 +420,7 @@ fn every_species_at_15_and_40_years_in_its_seasons_matches_its_golden_picture() 
             };
             let mesh = mesher.mesh_in(tree, season);
             let num_cards = mesh.cards().len();
+            let num_fruit_triangles = mesh.finest().map_or(0, |l| l.fruit.indices.len() / 3);
             renderer.set_tree(&gpu, mesh);
             let view = FrameView::tree_only(species_camera(years));
             let image = target
@@ -427,7 +428,8 @@ fn every_species_at_15_and_40_years_in_its_seasons_matches_its_golden_picture() 
                 .expect("offscreen frame");
             let picture = format!("species/{name}_{years}_{season}");
             println!(
-                "{picture}: {} internodes, {num_cards} cards, level {} drawn",
+                "{picture}: {} internodes, {num_cards} cards, {num_fruit_triangles} fruit \
+                 triangles, level {} drawn",
                 tree.skeleton.len(),
                 renderer.drawn_level()
             );
@@ -442,4 +444,31 @@ fn every_species_at_15_and_40_years_in_its_seasons_matches_its_golden_picture() 
         }
     }
     assert!(failures.is_empty(), "{} pictures differ", failures.len());
+}
+
+#[test]
+fn a_distant_tree_draws_a_coarser_level_of_detail_than_a_near_one() {
+    let tree = grown_tree();
+    let (lo, hi) = tree.bounds().expect("the tree has geometry");
+    let (centre, size) = (0.5 * (lo + hi), (hi - lo).length());
+    let mut bench = bench_with(&tree);
+    let k = Intrinsics::from_fov(WIDTH, HEIGHT, 1.0);
+    let mut levels = Vec::new();
+    for distance in [1.3, 5.0, 15.0, 60.0].map(|f| f * size) {
+        let eye = centre + Vec3::new(0.0, 0.3, 1.0).normalize() * distance;
+        let mut camera = ViewCamera::looking_at(k, eye, centre);
+        camera.far = 2.0 * distance;
+        let image = bench.render(&FrameView::tree_only(camera));
+        levels.push(bench.renderer.drawn_level());
+        let covered = num_pixels_unlike(&image, *image.get_pixel(2, 2));
+        assert!(covered > 0, "the tree at {distance} m is drawn");
+    }
+    println!("levels drawn from near to far: {levels:?}");
+    assert_eq!(levels[0], 0, "near, the finest level");
+    assert_eq!(levels[3], 2, "far, the coarsest level");
+    assert!(levels.windows(2).all(|w| w[0] <= w[1]), "{levels:?}");
+    assert!(
+        tree.levels[2].num_triangles() * 4 < tree.levels[0].num_triangles(),
+        "the coarsest level draws far fewer triangles"
+    );
 }

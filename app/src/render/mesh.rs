@@ -76,17 +76,19 @@ impl CardInstance {
     }
 }
 
-/// One level of detail of the drawn tree: its bark and its leaf cards.
+/// One level of detail of the drawn tree: its bark, its leaf cards and its fruit.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct TreeLevel {
     pub branches: LitMesh,
     pub cards: Vec<CardInstance>,
+    /// Fruit of the season (acorns), in [`TreeLook::fruit_color`]; empty for none.
+    pub fruit: LitMesh,
 }
 
 impl TreeLevel {
-    /// Triangles drawn: the bark's and two per card.
+    /// Triangles drawn: the bark's, two per card and the fruit's.
     pub fn num_triangles(&self) -> usize {
-        self.branches.indices.len() / 3 + 2 * self.cards.len()
+        (self.branches.indices.len() + self.fruit.indices.len()) / 3 + 2 * self.cards.len()
     }
 
     /// Bounds of the bark and the cards' corners, `None` when empty.
@@ -116,6 +118,8 @@ pub struct TreeLook {
     pub bark_color: [f32; 3],
     /// How the leaves lie on a card.
     pub leaf_card: LeafCard,
+    /// Linear RGB of the fruit.
+    pub fruit_color: [f32; 3],
 }
 
 impl Default for TreeLook {
@@ -127,6 +131,7 @@ impl Default for TreeLook {
             bark_kind: BarkKind::default(),
             bark_color: [0.30, 0.21, 0.14],
             leaf_card: LeafCard::default(),
+            fruit_color: [0.65, 0.06, 0.04],
         }
     }
 }

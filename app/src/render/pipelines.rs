@@ -20,6 +20,7 @@ pub struct Pipelines {
     pub branches: wgpu::RenderPipeline,
     /// Leaf cards: instances of one quad, alpha to coverage, lit on both sides.
     pub cards: wgpu::RenderPipeline,
+    pub fruit: wgpu::RenderPipeline,
     pub wire: wgpu::RenderPipeline,
     pub points: wgpu::RenderPipeline,
     pub brush: wgpu::RenderPipeline,
@@ -131,6 +132,11 @@ impl Pipelines {
             cull: Some(wgpu::Face::Back),
             ..Spec::opaque("branches", "vs_lit", "fs_branch")
         });
+        let fruit = make(Spec {
+            buffer: Some(lit_layout()),
+            cull: Some(wgpu::Face::Back),
+            ..Spec::opaque("fruit", "vs_lit", "fs_fruit")
+        });
         let cards = make(Spec {
             buffer: Some(card_layout()),
             alpha_to_coverage: true,
@@ -172,6 +178,7 @@ impl Pipelines {
             ground_lawn,
             branches,
             cards,
+            fruit,
             wire,
             points,
             brush,

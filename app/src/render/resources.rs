@@ -7,7 +7,7 @@ use crate::render::buffers::{GpuMesh, draw, upload};
 use crate::render::camera::Intrinsics;
 use crate::render::mesh::{OccluderMesh, TreeMesh};
 use crate::render::pipelines::{DEPTH_FORMAT, Pipelines, SAMPLE_COUNT};
-use crate::render::tree_gpu::GpuTree;
+use crate::render::tree_gpu::{GpuTree, TreePipelines};
 use crate::render::{FrameView, Gpu, GroundStyle};
 
 /// Side of the square shadow map, texels.
@@ -31,6 +31,8 @@ struct Globals {
     image: [f32; 4],
     viewport: [f32; 4],
     misc: [f32; 4],
+    /// rgb: linear colour of the tree's fruit; w unused.
+    fruit_color: [f32; 4],
 }
 
 struct Background {
@@ -342,8 +344,12 @@ impl Renderer {
             });
             pass.draw(0..6, 0..1);
         }
-        self.tree
-            .draw(&mut pass, self.drawn_level, &p.branches, &p.cards);
+        let parts = TreePipelines {
+            branches: &p.branches,
+            cards: &p.cards,
+            fruit: &p.fruit,
+        };
+        self.tree.draw(&mut pass, self.drawn_level, parts);
         if view.debug.depth_wireframe {
             draw(&mut pass, &p.wire, self.wireframe.as_ref());
         }
@@ -379,12 +385,12 @@ impl Renderer {
         pass.set_bind_group(0, &self.shadow_group, &[]);
         pass.set_bind_group(1, self.tree.group(), &[]);
         let p = &self.pipelines;
-        self.tree.draw(
-            &mut pass,
-            self.drawn_level,
-            &p.shadow_branches,
-            &p.shadow_cards,
-        );
+        let parts = TreePipelines {
+            branches: &p.shadow_branches,
+            cards: &p.shadow_cards,
+            fruit: &p.shadow_branches,
+        };
+        self.tree.draw(&mut pass, self.drawn_level, parts);
     }
 
     fn globals_for(&self, view: &FrameView, region: [f32; 4]) -> Globals {
@@ -437,6 +443,7 @@ impl Renderer {
             ],
             viewport: region,
             misc: [3.0, texel, 1.5, 0.0],
+            fruit_color: Vec3::from(self.tree.fruit_color()).extend(1.0).to_array(),
         }
     }
 }

@@ -26,6 +26,8 @@ struct Globals {
     viewport: vec4<f32>,
     // point size (px), shadow map texel size (uv), PCF spacing (texels), unused.
     misc: vec4<f32>,
+    // rgb: linear colour of the tree's fruit; w unused.
+    fruit_color: vec4<f32>,
 }
 
 @group(0) @binding(0) var<uniform> g: Globals;
@@ -108,6 +110,11 @@ fn fs_branch(v: LitOut) -> @location(0) vec4<f32> {
     let n = normalize(v.normal);
     let bark = textureSample(bark_texture, tree_sampler, v.uv).rgb;
     return vec4<f32>(shade(bark, n, v.world, v.ambient), 1.0);
+}
+
+@fragment
+fn fs_fruit(v: LitOut) -> @location(0) vec4<f32> {
+    return vec4<f32>(shade(g.fruit_color.rgb, normalize(v.normal), v.world, v.ambient), 1.0);
 }
 
 // ---- leaf cards: one quad, instanced; two-sided ----

@@ -15,6 +15,15 @@ struct GpuLevel {
     branches: Option<GpuMesh>,
     /// Leaf card instances.
     cards: Option<GpuMesh>,
+    fruit: Option<GpuMesh>,
+}
+
+/// The pipelines a pass draws the tree's parts with.
+#[derive(Clone, Copy)]
+pub(super) struct TreePipelines<'a> {
+    pub branches: &'a wgpu::RenderPipeline,
+    pub cards: &'a wgpu::RenderPipeline,
+    pub fruit: &'a wgpu::RenderPipeline,
 }
 
 /// The uploaded tree.
@@ -66,6 +75,7 @@ impl GpuTree {
             .map(|level| GpuLevel {
                 branches: upload_lit(device, &level.branches),
                 cards: upload(device, &level.cards, None),
+                fruit: upload_lit(device, &level.fruit),
             })
             .collect();
         self.card_side_m = mean_card_side_m(tree.cards());
@@ -81,6 +91,11 @@ impl GpuTree {
 
     pub fn bounds(&self) -> Option<(Vec3, Vec3)> {
         self.bounds
+    }
+
+    /// Linear RGB of the fruit.
+    pub fn fruit_color(&self) -> [f32; 3] {
+        self.look.as_ref().map_or([0.0; 3], |l| l.fruit_color)
     }
 
     /// The textures' bind group (group 1 of every pipeline).
@@ -104,17 +119,12 @@ impl GpuTree {
         level_for_card_px(self.card_side_m * px_per_m, self.levels.len())
     }
 
-    /// Draws level `level`'s bark with `branches` and its cards with `cards`.
-    pub fn draw(
-        &self,
-        pass: &mut wgpu::RenderPass<'_>,
-        level: usize,
-        branches: &wgpu::RenderPipeline,
-        cards: &wgpu::RenderPipeline,
-    ) {
+    /// Draws level `level` with `pipelines`: bark, leaf cards and fruit.
+    pub fn draw(&self, pass: &mut wgpu::RenderPass<'_>, level: usize, pipelines: TreePipelines) {
         if let Some(level) = self.levels.get(level) {
-            draw(pass, branches, level.branches.as_ref());
-            draw_cards(pass, cards, level.cards.as_ref());
+            draw(pass, pipelines.branches, level.branches.as_ref());
+            draw_cards(pass, pipelines.cards, level.cards.as_ref());
+            draw(pass, pipelines.fruit, level.fruit.as_ref());
         }
     }
 }
