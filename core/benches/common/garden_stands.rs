@@ -38,10 +38,11 @@ pub type Edit = fn(&mut sylva_core::Tree);
 
 /// The edits of one tree timed against its garden (issue #24, Done when 5), each as a plain
 /// function of the tree so the same edit can be applied in the garden and to the tree alone.
-pub const EDITS: [(&str, Edit); 3] = [
+pub const EDITS: [(&str, Edit); 4] = [
     ("brush", brush_edit),
     ("prune", prune_edit),
     ("parameters", parameter_edit),
+    ("regrow", regrow_edit),
 ];
 
 /// A brush dab of 300 points in a 0.5 m sphere beside the crown's top, grown towards in three
@@ -75,6 +76,16 @@ fn prune_edit(tree: &mut sylva_core::Tree) {
 fn parameter_edit(tree: &mut sylva_core::Tree) {
     tree.species.apical_dominance *= 0.9;
     tree.grow_years(1.0);
+}
+
+/// Apical dominance lowered by a tenth and the tree regrown from a seedling to its age, as a
+/// design regrows after a slider moves.
+fn regrow_edit(tree: &mut sylva_core::Tree) {
+    let mut species = tree.species.clone();
+    species.apical_dominance *= 0.9;
+    let age_years = tree.age_years();
+    *tree = sylva_core::Tree::new(species, 7);
+    tree.grow_years(age_years);
 }
 
 /// The tree `index` of `garden` as if it stood alone: its own shade only, no neighbours.
