@@ -163,7 +163,7 @@ impl Garden {
         }
         competition::link_neighbours(self);
         competition::gather_neighbour_nodes(self, due);
-        competition::set_neighbour_tropisms(self);
+        competition::set_neighbour_tropisms(self, due);
         let before: Vec<Option<Vec<Vec3>>> = self
             .trees
             .par_iter()
@@ -208,7 +208,7 @@ impl Garden {
         due[index] = true;
         competition::link_neighbours(self);
         competition::gather_neighbour_nodes(self, &due);
-        competition::set_neighbour_tropisms(self);
+        competition::set_neighbour_tropisms(self, &due);
         // The edit may grow anywhere: from now on the tree's grid holds all its linked
         // neighbours' shade (cast once, at its first edit; see module `shade`).
         competition::set_shade_everywhere(self, index);

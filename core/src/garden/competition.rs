@@ -229,25 +229,48 @@ const PRESSURE_DISTANCE_WEIGHT: f32 = 0.5;
 /// at most 1 long (this garden has no constraint volume, so eq. 6.4's space factor is 1); the
 /// tropism is (1 − α) V_i with α = (h/h_max)^½, h the tree's height and h_max the height its
 /// species reaches at 30 years: it fades out as the tree grows.
-pub(super) fn set_neighbour_tropisms(garden: &mut Garden) {
-    let crowns: Vec<(Vec2, f32, f32)> = garden
+///
+/// Only the trees that are `due` get theirs (the others do not grow before they are due again);
+/// only their crowns and those of the trees within their r are measured.
+pub(super) fn set_neighbour_tropisms(garden: &mut Garden, due: &[bool]) {
+    let bases: Vec<Vec2> = garden
         .trees
-        .par_iter()
-        .map(|t| {
-            let crown = super::CrownStats::of(t);
-            let area = std::f32::consts::PI * crown.radius_m().max(0.05).powi(2);
-            (Vec2::new(t.x_m, t.z_m), area, t.tree.metrics().height_m)
+        .iter()
+        .map(|t| Vec2::new(t.x_m, t.z_m))
+        .collect();
+    let reach = |t: &GardenTree| t.tree.species.expected.spread_30y_m.max(0.5);
+    let needed: Vec<bool> = (0..garden.trees.len())
+        .into_par_iter()
+        .map(|j| {
+            due[j]
+                || (0..bases.len())
+                    .any(|i| due[i] && bases[i].distance(bases[j]) < reach(&garden.trees[i]))
         })
         .collect();
-    let tropisms: Vec<glam::Vec3> = (0..garden.trees.len())
+    let areas: Vec<f32> = garden
+        .trees
+        .par_iter()
+        .zip(&needed)
+        .map(|(t, &needed)| {
+            if !needed {
+                return 0.0;
+            }
+            let crown = super::CrownStats::of(t);
+            std::f32::consts::PI * crown.radius_m().max(0.05).powi(2)
+        })
+        .collect();
+    let tropisms: Vec<Option<glam::Vec3>> = (0..garden.trees.len())
         .into_par_iter()
         .map(|i| {
+            if !due[i] {
+                return None;
+            }
             let t = &garden.trees[i];
             let expected = &t.tree.species.expected;
-            let r = expected.spread_30y_m.max(0.5);
-            let (base, area, height) = crowns[i];
+            let r = reach(t);
+            let (base, area) = (bases[i], areas[i]);
             let mut v = Vec2::ZERO;
-            for (j, &(other, other_area, _)) in crowns.iter().enumerate() {
+            for (j, (&other, &other_area)) in bases.iter().zip(&areas).enumerate() {
                 let d = base.distance(other);
                 if j == i || d >= r || d <= 0.0 {
                     continue;
@@ -257,14 +280,17 @@ pub(super) fn set_neighbour_tropisms(garden: &mut Garden) {
                 v += weight * (base - other) / d;
             }
             let v = v.clamp_length_max(1.0);
+            let height = t.tree.metrics().height_m;
             let alpha = (height / expected.height_30y_m.max(0.5))
                 .clamp(0.0, 1.0)
                 .sqrt();
-            glam::Vec3::new(v.x, 0.0, v.y) * (1.0 - alpha)
+            Some(glam::Vec3::new(v.x, 0.0, v.y) * (1.0 - alpha))
         })
         .collect();
     for (t, v) in garden.trees.iter_mut().zip(tropisms) {
-        t.tree.environment.neighbour_tropism = v;
+        if let Some(v) = v {
+            t.tree.environment.neighbour_tropism = v;
+        }
     }
 }
 
