@@ -8,9 +8,11 @@
 //! than a year; each tree spreads its iterations evenly over the rounds). Before every round each
 //! tree's environment is brought up to date with its neighbours (module `competition`):
 //!
-//! - **shared shade**: every node of a neighbour casts its shadow pyramid into the tree's shadow
-//!   grid, so a tall neighbour shades the buds below and beside it (integer sums, so the grid is
-//!   the same whatever the order the pyramids arrive in);
+//! - **shared shade**: the nodes of a neighbour cast their shadow pyramids into the tree's
+//!   shadow grid, so a tall neighbour shades the buds below and beside it (integer sums, so the
+//!   grid is the same whatever the order the pyramids arrive in); only near the tree's own
+//!   nodes, where the grid is read (module `shade`), so the grid reads there exactly the shade
+//!   of all of them;
 //! - **space**: the neighbours' nodes within reach occupy space as the tree's own do
 //!   ([`crate::environment::Environment::neighbour_nodes`]): no bud takes the space a
 //!   neighbour's internodes hold;

@@ -5,7 +5,9 @@
 
 mod support;
 
-use sylva_core::export::{SceneTree, garden_glb_bytes, glb_bytes, write_garden_glb};
+use sylva_core::export::{
+    SceneTree, garden_glb_bytes, glb_bytes, write_garden_glb, write_garden_obj,
+};
 use sylva_core::garden::{Garden, PlantedTree};
 use sylva_core::species::Species;
 
@@ -130,6 +132,60 @@ fn a_garden_glb_passes_the_validator_with_one_node_per_tree_and_shared_textures(
         "{} bytes for one tree, its own file {one_expected}",
         one.len()
     );
+}
+
+#[test]
+fn a_garden_obj_has_one_group_per_tree_every_triangle_and_one_material_set_per_species() {
+    let garden = ten_trees();
+    let meshes = garden.tree_meshes();
+    let trees = scene(&garden, &meshes);
+    let dir = tempfile::tempdir().expect("temp dir");
+    let path = dir.path().join("garden.obj");
+    write_garden_obj(&trees, &path).expect("garden obj written");
+    let obj = std::fs::read_to_string(&path).expect("reads");
+    let groups: Vec<&str> = obj.lines().filter(|l| l.starts_with("g ")).collect();
+    assert_eq!(groups.len(), 10);
+    assert_eq!(groups[3], "g tree_3_maple");
+    let num_vertices = obj.lines().filter(|l| l.starts_with("v ")).count();
+    let faces: Vec<&str> = obj.lines().filter(|l| l.starts_with("f ")).collect();
+    let triangles: usize = meshes
+        .iter()
+        .map(|m| {
+            let lod = &m.lods[0];
+            (lod.branches.indices.len() + lod.num_leaf_indices + lod.num_fruit_indices) / 3
+        })
+        .sum();
+    assert_eq!(faces.len(), triangles);
+    let largest = faces
+        .iter()
+        .flat_map(|f| f.split_whitespace().skip(1))
+        .map(|c| {
+            c.split('/')
+                .next()
+                .and_then(|v| v.parse::<usize>().ok())
+                .expect("index")
+        })
+        .max()
+        .expect("faces");
+    assert_eq!(
+        largest, num_vertices,
+        "the last tree's indices reach the last vertex"
+    );
+    let mtl = std::fs::read_to_string(path.with_extension("mtl")).expect("mtl");
+    let leafs: Vec<&str> = mtl
+        .lines()
+        .filter(|l| l.starts_with("newmtl") && l.ends_with("_leaf"))
+        .collect();
+    assert_eq!(leafs, ["newmtl birch_leaf", "newmtl maple_leaf"]);
+    let pngs = std::fs::read_dir(dir.path())
+        .expect("dir")
+        .filter(|e| {
+            e.as_ref()
+                .is_ok_and(|e| e.path().extension().is_some_and(|x| x == "png"))
+        })
+        .count();
+    assert_eq!(pngs, 4, "bark and leaf textures once per species");
+    assert!(mtl.contains("map_Kd garden_maple_leaf.png"), "{mtl}");
 }
 
 #[test]

@@ -413,3 +413,141 @@ fn merge_tree(
         json!({ "name": tree.name, "translation": [t.x, t.y, t.z], "children": roots }),
     ))
 }
+
+/// Writes the garden scene `trees` to `path` as Wavefront OBJ: one group per tree (`g` with
+/// its name), its parts as objects, placed at the tree's base; `path` with extension `.mtl`
+/// holds each species' materials once (`<species>_bark`, `<species>_leaf`, `<species>_fruit`),
+/// and each species' textures are written once next to it (`<stem>_<species>_bark.png`, ...).
+/// Each tree is written by [`write_obj`] to a scratch folder next to `path` and merged.
+pub fn write_garden_obj(trees: &[SceneTree], path: &Path) -> Result<(), ExportError> {
+    if trees.is_empty() {
+        return Err(ExportError::Empty {
+            path: path.to_path_buf(),
+        });
+    }
+    let stem = path
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .filter(|s| !s.is_empty())
+        .unwrap_or("garden")
+        .to_string();
+    let scratch = path.with_file_name(format!(".{stem}.garden-scratch"));
+    std::fs::create_dir_all(&scratch).map_err(ExportError::io(&scratch))?;
+    let merged = merge_objs(trees, path, &stem, &scratch);
+    // The scratch folder goes whatever happened; an error removing it is not the user's.
+    let _ = std::fs::remove_dir_all(&scratch);
+    let (obj, mtl) = merged?;
+    let mtl_path = path.with_extension("mtl");
+    std::fs::write(&mtl_path, mtl).map_err(ExportError::io(&mtl_path))?;
+    std::fs::write(path, obj).map_err(ExportError::io(path))
+}
+
+/// The garden's OBJ and MTL text; textures copied next to `path`.
+fn merge_objs(
+    trees: &[SceneTree],
+    path: &Path,
+    stem: &str,
+    scratch: &Path,
+) -> Result<(String, String), ExportError> {
+    use std::fmt::Write;
+    let mut obj = format!("# Sylva garden: metres, Y up\nmtllib {stem}.mtl\n");
+    let mut mtl = String::from("# Sylva garden materials\n");
+    let mut species_done: Vec<String> = Vec::new();
+    // Vertices, texture coordinates and normals written so far (OBJ indices are global).
+    let mut offsets = [0usize; 3];
+    for (k, tree) in trees.iter().enumerate() {
+        let tree_path = scratch.join(format!("tree{k}.obj"));
+        super::write_obj(tree.meshes, &tree_path)?;
+        let species: String = tree
+            .species
+            .chars()
+            .map(|c| if c.is_alphanumeric() { c } else { '_' })
+            .collect();
+        let species = species.as_str();
+        if !species_done.iter().any(|s| s == species) {
+            species_done.push(species.to_string());
+            let text = std::fs::read_to_string(tree_path.with_extension("mtl"))
+                .map_err(ExportError::io(&tree_path))?;
+            for line in text.lines().filter(|l| !l.starts_with('#')) {
+                let mut words: Vec<String> = line.split_whitespace().map(String::from).collect();
+                match words.first().map(String::as_str) {
+                    Some("newmtl") if words.len() == 2 => {
+                        words[1] = format!("{species}_{}", words[1])
+                    }
+                    Some(map) if map.starts_with("map_") && words.len() >= 2 => {
+                        let texture = words.pop().unwrap_or_default();
+                        let suffix = texture
+                            .strip_prefix(&format!("tree{k}"))
+                            .unwrap_or(&texture);
+                        let name = format!("{stem}_{species}{suffix}");
+                        let from = scratch.join(&texture);
+                        let to = path.with_file_name(&name);
+                        std::fs::copy(&from, &to).map_err(ExportError::io(&to))?;
+                        words.push(name);
+                    }
+                    _ => {}
+                }
+                let _ = writeln!(mtl, "{}", words.join(" "));
+            }
+        }
+        let text = std::fs::read_to_string(&tree_path).map_err(ExportError::io(&tree_path))?;
+        let _ = writeln!(obj, "g {}", tree.name.replace(char::is_whitespace, "_"));
+        let mut counts = [0usize; 3];
+        let t = tree.translation;
+        for line in text.lines() {
+            let mut words = line.split_whitespace();
+            let bad = || ExportError::Encode {
+                path: path.to_path_buf(),
+                what: "garden OBJ",
+                reason: format!("a tree's OBJ line {line:?} does not parse"),
+            };
+            match words.next() {
+                Some("v") => {
+                    let p: Vec<f32> = words
+                        .map(str::parse)
+                        .collect::<Result<_, _>>()
+                        .map_err(|_| bad())?;
+                    let [x, y, z] = p[..] else { return Err(bad()) };
+                    let _ = writeln!(obj, "v {} {} {}", x + t.x, y + t.y, z + t.z);
+                    counts[0] += 1;
+                }
+                Some(kind @ ("vt" | "vn")) => {
+                    let _ = writeln!(obj, "{line}");
+                    counts[if kind == "vt" { 1 } else { 2 }] += 1;
+                }
+                Some("f") => {
+                    obj.push('f');
+                    for corner in words {
+                        obj.push(' ');
+                        for (slot, index) in corner.split('/').enumerate() {
+                            if slot > 0 {
+                                obj.push('/');
+                            }
+                            if !index.is_empty() {
+                                let i: usize = index.parse().map_err(|_| bad())?;
+                                let _ = write!(obj, "{}", i + offsets[slot.min(2)]);
+                            }
+                        }
+                    }
+                    obj.push('\n');
+                }
+                Some("o") => {
+                    let part = words.next().unwrap_or("part");
+                    let _ = writeln!(
+                        obj,
+                        "o {}_{part}",
+                        tree.name.replace(char::is_whitespace, "_")
+                    );
+                }
+                Some("usemtl") => {
+                    let _ = writeln!(obj, "usemtl {species}_{}", words.next().unwrap_or_default());
+                }
+                _ => {}
+            }
+        }
+        for (offset, count) in offsets.iter_mut().zip(counts) {
+            *offset += count;
+        }
+    }
+    Ok((obj, mtl))
+}

@@ -17,7 +17,7 @@ mod obj;
 
 use std::path::{Path, PathBuf};
 
-pub use garden::{SceneTree, garden_glb_bytes, write_garden_glb};
+pub use garden::{SceneTree, garden_glb_bytes, write_garden_glb, write_garden_obj};
 pub use glb::{glb_bytes, write_glb};
 pub use obj::write_obj;
 

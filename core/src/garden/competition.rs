@@ -7,10 +7,13 @@
 //! it out changes nothing. Once linked a pair stays linked (the links are saved with the garden),
 //! so a neighbour's shade never flickers in and out.
 //!
-//! **Shade.** When j is linked to i, every node of j casts its pyramid into i's shadow grid (in
-//! i's space); after each round the nodes j grew are added and those it shed are taken away.
-//! Integer sums: the grid is exactly i's own shade plus that of its linked neighbours' current
-//! nodes, whatever the order.
+//! **Shade.** When j is linked to i, the nodes of j within i's shade cover (module `shade`: the
+//! cells around i's own nodes) cast their pyramids into i's shadow grid (in i's space); after
+//! each round the nodes j grew there are added and those it shed taken away, and the cells i's
+//! new nodes open take in the neighbours' nodes already standing in them (found through the
+//! neighbours' node indexes, module `index`). Integer sums: at every node of i the grid reads
+//! exactly i's own shade plus that of all its linked neighbours' current nodes, whatever the
+//! order.
 //!
 //! **Space.** Before each round a tree due to grow gets, as occupied space in its own space, the
 //! nodes of its linked neighbours close enough to take an attraction point from it.
