@@ -9,7 +9,7 @@ use sylva_core::garden::{
     Garden, Layout, MAX_GARDEN_YEARS, Planting, PlantingFile, RIPLEY_RADIUS_M, ripley_excess,
 };
 
-use sylva_core::export::{SceneTree, write_garden_glb};
+use sylva_core::export::{SceneTree, write_garden_glb, write_garden_obj};
 
 use crate::cmd_grow::load_species;
 
@@ -44,6 +44,10 @@ pub struct GardenArgs {
     /// textures and materials shared by the trees of a species.
     #[arg(long)]
     pub glb: Option<PathBuf>,
+    /// Also write the garden as Wavefront OBJ + MTL: one group per tree, textures once per
+    /// species next to it.
+    #[arg(long)]
+    pub obj: Option<PathBuf>,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug)]
@@ -142,7 +146,7 @@ pub fn garden(args: GardenArgs) -> anyhow::Result<()> {
     garden.grow_years(args.years);
     let elapsed_ms = started.elapsed().as_secs_f64() * 1000.0;
     garden.save(&args.out)?;
-    if let Some(path) = &args.glb {
+    if args.glb.is_some() || args.obj.is_some() {
         let meshes = garden.tree_meshes();
         let scene: Vec<SceneTree> = garden
             .trees
@@ -156,7 +160,12 @@ pub fn garden(args: GardenArgs) -> anyhow::Result<()> {
                 meshes,
             })
             .collect();
-        write_garden_glb(&scene, path)?;
+        if let Some(path) = &args.glb {
+            write_garden_glb(&scene, path)?;
+        }
+        if let Some(path) = &args.obj {
+            write_garden_obj(&scene, path)?;
+        }
     }
     let crowns = garden.crowns();
     let bases: Vec<Vec2> = crowns

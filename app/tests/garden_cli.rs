@@ -48,6 +48,8 @@ fn a_planting_file_grows_into_a_garden_that_loads_back_with_a_summary_line_last(
         out.to_str().expect("utf-8"),
         "--glb",
         glb.to_str().expect("utf-8"),
+        "--obj",
+        dir.path().join("garden.obj").to_str().expect("utf-8"),
     ]);
     assert!(output.status.success(), "{output:?}");
     let line = last_line(&output);
@@ -80,6 +82,10 @@ fn a_planting_file_grows_into_a_garden_that_loads_back_with_a_summary_line_last(
     assert_eq!(node(0)["name"], "tree 0 birch (planting 0 (row))");
     assert_eq!(node(3)["name"], "tree 3 oak (planting 1 (tree))");
     assert_eq!(node(3)["translation"], serde_json::json!([0.0, 0.0, 3.0]));
+    // The .obj: one group per tree.
+    let obj = std::fs::read_to_string(dir.path().join("garden.obj")).expect("the obj is written");
+    assert_eq!(obj.lines().filter(|l| l.starts_with("g ")).count(), 4);
+    assert!(dir.path().join("garden.mtl").is_file());
 }
 
 #[test]

@@ -164,12 +164,18 @@ fn view_bytes<'a>(view: &Value, bin: &'a [u8]) -> Option<&'a [u8]> {
     bin.get(offset..offset.checked_add(length)?)
 }
 
-fn build(trees: &[SceneTree], path: &Path) -> Result<Vec<u8>, ExportError> {
-    if trees.is_empty() {
-        return Err(ExportError::Empty {
+/// An empty scene is an error naming the file.
+fn some_trees(trees: &[SceneTree], path: &Path) -> Result<(), ExportError> {
+    match trees {
+        [] => Err(ExportError::Empty {
             path: path.to_path_buf(),
-        });
+        }),
+        _ => Ok(()),
     }
+}
+
+fn build(trees: &[SceneTree], path: &Path) -> Result<Vec<u8>, ExportError> {
+    some_trees(trees, path)?;
     let mut merged = Merged {
         doc: Map::new(),
         bin: Vec::new(),
@@ -420,17 +426,11 @@ fn merge_tree(
 /// and each species' textures are written once next to it (`<stem>_<species>_bark.png`, ...).
 /// Each tree is written by [`write_obj`] to a scratch folder next to `path` and merged.
 pub fn write_garden_obj(trees: &[SceneTree], path: &Path) -> Result<(), ExportError> {
-    if trees.is_empty() {
-        return Err(ExportError::Empty {
-            path: path.to_path_buf(),
-        });
-    }
-    let stem = path
-        .file_stem()
-        .and_then(|s| s.to_str())
-        .filter(|s| !s.is_empty())
-        .unwrap_or("garden")
-        .to_string();
+    some_trees(trees, path)?;
+    let stem = match path.file_stem().and_then(|s| s.to_str()) {
+        Some(stem) if !stem.is_empty() => stem.to_string(),
+        _ => "garden".to_string(),
+    };
     let scratch = path.with_file_name(format!(".{stem}.garden-scratch"));
     std::fs::create_dir_all(&scratch).map_err(ExportError::io(&scratch))?;
     let merged = merge_objs(trees, path, &stem, &scratch);
