@@ -9,6 +9,8 @@ use sylva_core::garden::{
     Garden, Layout, MAX_GARDEN_YEARS, Planting, PlantingFile, RIPLEY_RADIUS_M, ripley_excess,
 };
 
+use sylva_core::export::{SceneTree, write_garden_glb, write_garden_obj};
+
 use crate::cmd_grow::load_species;
 
 /// Arguments of `sylva garden`.
@@ -38,6 +40,14 @@ pub struct GardenArgs {
     /// Where to save the garden (versioned JSON).
     #[arg(long)]
     pub out: PathBuf,
+    /// Also write the garden as binary glTF: one node per tree, named by its planting entry,
+    /// textures and materials shared by the trees of a species.
+    #[arg(long)]
+    pub glb: Option<PathBuf>,
+    /// Also write the garden as Wavefront OBJ + MTL: one group per tree, textures once per
+    /// species next to it.
+    #[arg(long)]
+    pub obj: Option<PathBuf>,
 }
 
 #[derive(clap::ValueEnum, Clone, Copy, Debug)]
@@ -126,11 +136,37 @@ pub fn garden(args: GardenArgs) -> anyhow::Result<()> {
     let trees = file
         .trees(&resolve)
         .with_context(|| format!("bad planting in {origin}"))?;
+    let names: Vec<String> = trees
+        .iter()
+        .enumerate()
+        .map(|(k, t)| format!("tree {k} {} (planting {})", t.species.name, t.entry))
+        .collect();
     let started = Instant::now();
     let mut garden = Garden::plant(trees).with_context(|| format!("bad planting in {origin}"))?;
     garden.grow_years(args.years);
     let elapsed_ms = started.elapsed().as_secs_f64() * 1000.0;
     garden.save(&args.out)?;
+    if args.glb.is_some() || args.obj.is_some() {
+        let meshes = garden.tree_meshes();
+        let scene: Vec<SceneTree> = garden
+            .trees
+            .iter()
+            .zip(&meshes)
+            .zip(names)
+            .map(|((t, meshes), name)| SceneTree {
+                name,
+                species: t.tree.species.name.clone(),
+                translation: t.base(),
+                meshes,
+            })
+            .collect();
+        if let Some(path) = &args.glb {
+            write_garden_glb(&scene, path)?;
+        }
+        if let Some(path) = &args.obj {
+            write_garden_obj(&scene, path)?;
+        }
+    }
     let crowns = garden.crowns();
     let bases: Vec<Vec2> = crowns
         .iter()

@@ -37,6 +37,7 @@ fn a_planting_file_grows_into_a_garden_that_loads_back_with_a_summary_line_last(
     )
     .expect("writes");
     let out = dir.path().join("garden.json");
+    let glb = dir.path().join("garden.glb");
     let output = sylva(&[
         "garden",
         "--planting",
@@ -45,6 +46,10 @@ fn a_planting_file_grows_into_a_garden_that_loads_back_with_a_summary_line_last(
         "6",
         "--out",
         out.to_str().expect("utf-8"),
+        "--glb",
+        glb.to_str().expect("utf-8"),
+        "--obj",
+        dir.path().join("garden.obj").to_str().expect("utf-8"),
     ]);
     assert!(output.status.success(), "{output:?}");
     let line = last_line(&output);
@@ -67,6 +72,20 @@ fn a_planting_file_grows_into_a_garden_that_loads_back_with_a_summary_line_last(
     );
     assert_eq!(garden.trees[3].tree.species.name, "oak");
     assert_eq!(garden.years, 6.0);
+    // The .glb: one node per tree in its scene, named by its planting entry, at its place.
+    let bytes = std::fs::read(&glb).expect("the glb is written");
+    let length = u32::from_le_bytes(bytes[12..16].try_into().expect("header")) as usize;
+    let json: serde_json::Value = serde_json::from_slice(&bytes[20..20 + length]).expect("JSON");
+    let roots = json["scenes"][0]["nodes"].as_array().expect("scene nodes");
+    assert_eq!(roots.len(), 4);
+    let node = |k: usize| &json["nodes"][roots[k].as_u64().expect("index") as usize];
+    assert_eq!(node(0)["name"], "tree 0 birch (planting 0 (row))");
+    assert_eq!(node(3)["name"], "tree 3 oak (planting 1 (tree))");
+    assert_eq!(node(3)["translation"], serde_json::json!([0.0, 0.0, 3.0]));
+    // The .obj: one group per tree.
+    let obj = std::fs::read_to_string(dir.path().join("garden.obj")).expect("the obj is written");
+    assert_eq!(obj.lines().filter(|l| l.starts_with("g ")).count(), 4);
+    assert!(dir.path().join("garden.mtl").is_file());
 }
 
 #[test]

@@ -1,6 +1,6 @@
 //! Times gardens of mixed presets grown 20 years together (issue #24, Done when 4): 10 trees on a
 //! 10 × 10 m plot and 300 on a 30 × 30 m plot, random layout, on 1 thread and on all cores,
-//! printing wall-clock time, internodes, the Ripley excess of bases and crowns, and an FNV-1a
+//! printing wall-clock and process CPU time, internodes, the Ripley excess of bases and crowns, and an FNV-1a
 //! digest of each garden file (the same for every thread count).
 //!
 //! `cargo run --release -p sylva-core --example garden_timing [max_trees]`
@@ -15,6 +15,22 @@ mod garden_stands;
 use garden_stands::stand;
 #[path = "../benches/common/digest.rs"]
 mod digest;
+
+/// CPU time of the whole process so far, seconds (all threads): on a shared machine the wall
+/// time says how busy the others were, this how much the garden cost.
+fn process_cpu_s() -> f64 {
+    let mut ts = libc::timespec {
+        tv_sec: 0,
+        tv_nsec: 0,
+    };
+    // SAFETY: `ts` is a valid, writable timespec; the call only writes to it.
+    let status = unsafe { libc::clock_gettime(libc::CLOCK_PROCESS_CPUTIME_ID, &mut ts) };
+    if status == 0 {
+        ts.tv_sec as f64 + ts.tv_nsec as f64 * 1e-9
+    } else {
+        f64::NAN
+    }
+}
 
 fn main() {
     let max: usize = std::env::args()
@@ -31,11 +47,15 @@ fn main() {
                 .num_threads(threads)
                 .build()
                 .expect("thread pool");
-            let (elapsed_s, garden) = pool.install(|| {
-                let started = Instant::now();
+            let (elapsed_s, cpu_s, garden) = pool.install(|| {
+                let (started, cpu_started) = (Instant::now(), process_cpu_s());
                 let mut garden = stand(count, side_m, 2014);
                 garden.grow_years(20.0);
-                (started.elapsed().as_secs_f64(), garden)
+                (
+                    started.elapsed().as_secs_f64(),
+                    process_cpu_s() - cpu_started,
+                    garden,
+                )
             });
             let crowns = garden.crowns();
             let (lo, hi) = (Vec2::splat(-0.5 * side_m), Vec2::splat(0.5 * side_m));
@@ -48,7 +68,7 @@ fn main() {
                 .map(|c| Vec2::new(c.centroid.x, c.centroid.z))
                 .collect();
             println!(
-                "{count:3} trees on {side_m} x {side_m} m, 20 years, {threads} thread(s): {elapsed_s:.3} s wall, {} internodes, crown offset {:.3} m, Ripley excess bases {:?} crowns {:?}, digest {}",
+                "{count:3} trees on {side_m} x {side_m} m, 20 years, {threads} thread(s): {elapsed_s:.3} s wall, {cpu_s:.3} s CPU, {} internodes, crown offset {:.3} m, Ripley excess bases {:?} crowns {:?}, digest {}",
                 garden.num_internodes(),
                 garden.mean_crown_offset_m(),
                 ripley_excess(&bases, lo, hi, RIPLEY_RADIUS_M),

@@ -14,7 +14,7 @@ mod shadow;
 pub use attraction::{AttractionPoint, AttractionPoints};
 pub use candidates::Candidates;
 pub use grid::SpatialGrid;
-pub(crate) use grid::clear_with_room;
+pub(crate) use grid::{clear_with_room, floor_to_ivec3};
 pub use scene::{BoxScene, HalfSpace, Scene, SceneMode, SphereScene};
 pub use shadow::{MAX_SHADOW_DEPTH_VOXELS, MAX_VOXEL_COORD, ShadowGrid};
 

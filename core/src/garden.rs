@@ -8,9 +8,11 @@
 //! than a year; each tree spreads its iterations evenly over the rounds). Before every round each
 //! tree's environment is brought up to date with its neighbours (module `competition`):
 //!
-//! - **shared shade**: every node of a neighbour casts its shadow pyramid into the tree's shadow
-//!   grid, so a tall neighbour shades the buds below and beside it (integer sums, so the grid is
-//!   the same whatever the order the pyramids arrive in);
+//! - **shared shade**: the nodes of a neighbour cast their shadow pyramids into the tree's
+//!   shadow grid, so a tall neighbour shades the buds below and beside it (integer sums, so the
+//!   grid is the same whatever the order the pyramids arrive in); only near the tree's own
+//!   nodes, where the grid is read (module `shade`), so the grid reads there exactly the shade
+//!   of all of them;
 //! - **space**: the neighbours' nodes within reach occupy space as the tree's own do
 //!   ([`crate::environment::Environment::neighbour_nodes`]): no bud takes the space a
 //!   neighbour's internodes hold;
@@ -26,8 +28,10 @@
 //! tree grows exactly that tree.
 
 mod competition;
+mod index;
 mod io;
 mod planting;
+mod shade;
 mod stats;
 
 pub use io::{GARDEN_FORMAT_VERSION, GardenFileError};
@@ -61,6 +65,12 @@ pub struct GardenTree {
     /// comes within reach it stays linked (see module `competition`).
     #[serde(default)]
     pub neighbours: Vec<u32>,
+    /// Where its shadow grid holds the neighbours' shade (derived, never saved).
+    #[serde(skip)]
+    pub(crate) shade_cover: shade::ShadeCover,
+    /// Its nodes by coarse cells of garden space (derived, never saved).
+    #[serde(skip)]
+    pub(crate) node_index: index::NodeIndex,
 }
 
 impl GardenTree {
@@ -105,6 +115,8 @@ impl Garden {
                     seed: p.seed,
                     tree,
                     neighbours: Vec::new(),
+                    shade_cover: shade::ShadeCover::default(),
+                    node_index: index::NodeIndex::default(),
                 }
             })
             .collect();
@@ -153,7 +165,7 @@ impl Garden {
         }
         competition::link_neighbours(self);
         competition::gather_neighbour_nodes(self, due);
-        competition::set_neighbour_tropisms(self);
+        competition::set_neighbour_tropisms(self, due);
         let before: Vec<Option<Vec<Vec3>>> = self
             .trees
             .par_iter()
@@ -167,6 +179,7 @@ impl Garden {
             .zip(before)
             .map(|(t, before)| before.map(|b| competition::NodeChanges::of(t, &b)))
             .collect();
+        competition::index_nodes(self, due);
         competition::hand_on_shade(self, &changes);
     }
 
@@ -197,12 +210,18 @@ impl Garden {
         due[index] = true;
         competition::link_neighbours(self);
         competition::gather_neighbour_nodes(self, &due);
-        competition::set_neighbour_tropisms(self);
+        competition::set_neighbour_tropisms(self, &due);
+        // The edit may grow anywhere: from now on the tree's grid holds all its linked
+        // neighbours' shade (cast once, at its first edit; see module `shade`).
+        competition::set_shade_everywhere(self, index);
         let before = competition::node_ends(&self.trees[index]);
         edit(&mut self.trees[index].tree);
         let mut changes: Vec<Option<competition::NodeChanges>> =
             (0..self.trees.len()).map(|_| None).collect();
         changes[index] = Some(competition::NodeChanges::of(&self.trees[index], &before));
+        let mut edited = vec![false; self.trees.len()];
+        edited[index] = true;
+        competition::index_nodes(self, &edited);
         competition::hand_on_shade(self, &changes);
         true
     }
@@ -211,6 +230,15 @@ impl Garden {
     /// plus that of its linked neighbours. Call after loading or changing trees by hand.
     pub fn rebuild_environment(&mut self) {
         competition::rebuild_shade(self);
+    }
+
+    /// The meshes of every tree (its species' summer look, in its own space), built in
+    /// parallel: what [`crate::export::write_garden_glb`] places.
+    pub fn tree_meshes(&self) -> Vec<crate::geometry::TreeMeshes> {
+        self.trees
+            .par_iter()
+            .map(|t| crate::geometry::build_tree_meshes(&t.tree))
+            .collect()
     }
 
     /// Total internodes of all trees.

@@ -14,9 +14,9 @@ use crate::geometry::{TreeMesh, TreeMeshes};
 /// The glTF extension naming a node's coarser levels of detail.
 const MSFT_LOD: &str = "MSFT_lod";
 
-const GLB_MAGIC: u32 = 0x4654_6C67; // "glTF"
-const CHUNK_JSON: u32 = 0x4E4F_534A;
-const CHUNK_BIN: u32 = 0x004E_4942;
+pub(super) const GLB_MAGIC: u32 = 0x4654_6C67; // "glTF"
+pub(super) const CHUNK_JSON: u32 = 0x4E4F_534A;
+pub(super) const CHUNK_BIN: u32 = 0x004E_4942;
 
 /// Writes `meshes` to `path` as binary glTF 2.0.
 pub fn write_glb(meshes: &TreeMeshes, path: &Path) -> Result<(), ExportError> {
@@ -402,7 +402,11 @@ fn build(meshes: &TreeMeshes, path: &Path) -> Result<Vec<u8>, ExportError> {
 }
 
 /// The GLB container around a JSON document and its binary buffer.
-fn container(mut json_bytes: Vec<u8>, bin: Vec<u8>, path: &Path) -> Result<Vec<u8>, ExportError> {
+pub(super) fn container(
+    mut json_bytes: Vec<u8>,
+    bin: Vec<u8>,
+    path: &Path,
+) -> Result<Vec<u8>, ExportError> {
     while !json_bytes.len().is_multiple_of(4) {
         json_bytes.push(b' ');
     }

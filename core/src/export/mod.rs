@@ -11,11 +11,13 @@
 //! the extension (Blender 3.4, three.js) show the finest level once; PBR metallic-roughness materials with embedded PNG textures; ambient light
 //! as `COLOR_0`. OBJ: the finest level only, textures written next to it.
 
+mod garden;
 mod glb;
 mod obj;
 
 use std::path::{Path, PathBuf};
 
+pub use garden::{SceneTree, garden_glb_bytes, write_garden_glb, write_garden_obj};
 pub use glb::{glb_bytes, write_glb};
 pub use obj::write_obj;
 

@@ -7,10 +7,13 @@
 //! it out changes nothing. Once linked a pair stays linked (the links are saved with the garden),
 //! so a neighbour's shade never flickers in and out.
 //!
-//! **Shade.** When j is linked to i, every node of j casts its pyramid into i's shadow grid (in
-//! i's space); after each round the nodes j grew are added and those it shed are taken away.
-//! Integer sums: the grid is exactly i's own shade plus that of its linked neighbours' current
-//! nodes, whatever the order.
+//! **Shade.** When j is linked to i, the nodes of j within i's shade cover (module `shade`: the
+//! cells around i's own nodes) cast their pyramids into i's shadow grid (in i's space); after
+//! each round the nodes j grew there are added and those it shed taken away, and the cells i's
+//! new nodes open take in the neighbours' nodes already standing in them (found through the
+//! neighbours' node indexes, module `index`). Integer sums: at every node of i the grid reads
+//! exactly i's own shade plus that of all its linked neighbours' current nodes, whatever the
+//! order.
 //!
 //! **Space.** Before each round a tree due to grow gets, as occupied space in its own space, the
 //! nodes of its linked neighbours close enough to take an attraction point from it.
@@ -20,7 +23,10 @@ use std::collections::HashSet;
 use glam::{IVec3, Vec2, Vec3};
 use rayon::prelude::*;
 
+use super::index::{CellSet, NodeIndex};
+use super::shade::ShadeCover;
 use super::{Garden, GardenTree};
+use crate::environment::floor_to_ivec3;
 
 /// Slack added to every reach, metres: far beyond the rounding of the boxes.
 const REACH_SLACK_M: f32 = 0.05;
@@ -65,9 +71,15 @@ pub(super) fn node_ends(t: &GardenTree) -> Vec<Vec3> {
         .collect()
 }
 
-/// Links every pair that has come within reach and hands the newly linked neighbour's whole
-/// shade to the tree it reaches.
+/// Links every pair that has come within reach and hands the newly linked neighbour's shade
+/// to the tree it reaches (the part its cover holds: module `shade`).
 pub(super) fn link_neighbours(garden: &mut Garden) {
+    garden
+        .trees
+        .par_iter_mut()
+        .filter(|t| !t.shade_cover.is_made())
+        .for_each(|t| t.shade_cover = ShadeCover::of(&t.tree));
+    index_nodes(garden, &vec![false; garden.trees.len()]);
     let boxes: Vec<(Vec2, Vec2)> = garden.trees.par_iter().map(crown_box).collect();
     let reaches: Vec<f32> = garden.trees.iter().map(reach_m).collect();
     let new_links: Vec<Vec<u32>> = (0..garden.trees.len())
@@ -102,12 +114,13 @@ pub(super) fn link_neighbours(garden: &mut Garden) {
         .zip(new_links)
         .for_each(|(t, links)| {
             let base = t.base();
+            let cover = &t.shade_cover;
             for &j in &links {
                 if let Some(ends) = &ends[j as usize] {
-                    t.tree
-                        .environment
-                        .shadow
-                        .apply_nodes(ends.iter().map(|&p| p - base), 1);
+                    t.tree.environment.shadow.apply_nodes(
+                        ends.iter().map(|&p| p - base).filter(|&p| cover.covers(p)),
+                        1,
+                    );
                 }
             }
             t.neighbours.extend(links);
@@ -167,22 +180,25 @@ pub(super) fn gather_neighbour_nodes(garden: &mut Garden, due: &[bool]) {
                 * s.internode_length_m
                 + REACH_SLACK_M;
             let cells = contact_cells(t, size);
-            let (lo, hi) = cells.iter().fold(
-                (IVec3::splat(i32::MAX), IVec3::splat(i32::MIN)),
-                |(lo, hi), &c| (lo.min(c), hi.max(c)),
-            );
             let base = t.base();
+            let (mut lo, mut hi) = (IVec3::splat(i32::MAX), IVec3::splat(i32::MIN));
+            let mut asked = CellSet::default();
+            for &c in &cells {
+                (lo, hi) = (lo.min(c), hi.max(c));
+                let corner = c.as_vec3() * size;
+                asked.add_box(base + corner, base + corner + Vec3::splat(size));
+            }
             let mut nodes = Vec::new();
             for &j in &t.neighbours {
                 let n = &garden.trees[j as usize];
                 let offset = n.base() - base;
-                for node in &n.tree.skeleton.internodes {
-                    let p = node.end + offset;
-                    let c = (p / size).floor().as_ivec3();
+                n.node_index.for_each_in(&asked, |end| {
+                    let p = end + offset;
+                    let c = floor_to_ivec3(p / size);
                     if c.cmpge(lo).all() && c.cmple(hi).all() && cells.contains(&c) {
                         nodes.push(p);
                     }
-                }
+                });
             }
             nodes
         })
@@ -190,6 +206,19 @@ pub(super) fn gather_neighbour_nodes(garden: &mut Garden, due: &[bool]) {
     for (t, nodes) in garden.trees.iter_mut().zip(gathered) {
         t.tree.environment.neighbour_nodes = nodes;
     }
+}
+
+/// Indexes anew the nodes of the trees marked `changed` and of any tree without an index.
+pub(super) fn index_nodes(garden: &mut Garden, changed: &[bool]) {
+    garden
+        .trees
+        .par_iter_mut()
+        .zip(changed)
+        .filter(|(t, c)| **c || !t.node_index.built)
+        .for_each(|(t, _)| {
+            t.node_index =
+                NodeIndex::of(t.base(), t.tree.skeleton.internodes.iter().map(|n| n.end));
+        });
 }
 
 /// Weights α_a (relative crown area) and α_d (nearness) of a neighbour's pressure (eq. 6.3).
@@ -203,25 +232,48 @@ const PRESSURE_DISTANCE_WEIGHT: f32 = 0.5;
 /// at most 1 long (this garden has no constraint volume, so eq. 6.4's space factor is 1); the
 /// tropism is (1 − α) V_i with α = (h/h_max)^½, h the tree's height and h_max the height its
 /// species reaches at 30 years: it fades out as the tree grows.
-pub(super) fn set_neighbour_tropisms(garden: &mut Garden) {
-    let crowns: Vec<(Vec2, f32, f32)> = garden
+///
+/// Only the trees that are `due` get theirs (the others do not grow before they are due again);
+/// only their crowns and those of the trees within their r are measured.
+pub(super) fn set_neighbour_tropisms(garden: &mut Garden, due: &[bool]) {
+    let bases: Vec<Vec2> = garden
         .trees
-        .par_iter()
-        .map(|t| {
-            let crown = super::CrownStats::of(t);
-            let area = std::f32::consts::PI * crown.radius_m().max(0.05).powi(2);
-            (Vec2::new(t.x_m, t.z_m), area, t.tree.metrics().height_m)
+        .iter()
+        .map(|t| Vec2::new(t.x_m, t.z_m))
+        .collect();
+    let reach = |t: &GardenTree| t.tree.species.expected.spread_30y_m.max(0.5);
+    let needed: Vec<bool> = (0..garden.trees.len())
+        .into_par_iter()
+        .map(|j| {
+            due[j]
+                || (0..bases.len())
+                    .any(|i| due[i] && bases[i].distance(bases[j]) < reach(&garden.trees[i]))
         })
         .collect();
-    let tropisms: Vec<glam::Vec3> = (0..garden.trees.len())
+    let areas: Vec<f32> = garden
+        .trees
+        .par_iter()
+        .zip(&needed)
+        .map(|(t, &needed)| {
+            if !needed {
+                return 0.0;
+            }
+            let crown = super::CrownStats::of(t);
+            std::f32::consts::PI * crown.radius_m().max(0.05).powi(2)
+        })
+        .collect();
+    let tropisms: Vec<Option<glam::Vec3>> = (0..garden.trees.len())
         .into_par_iter()
         .map(|i| {
+            if !due[i] {
+                return None;
+            }
             let t = &garden.trees[i];
             let expected = &t.tree.species.expected;
-            let r = expected.spread_30y_m.max(0.5);
-            let (base, area, height) = crowns[i];
+            let r = reach(t);
+            let (base, area) = (bases[i], areas[i]);
             let mut v = Vec2::ZERO;
-            for (j, &(other, other_area, _)) in crowns.iter().enumerate() {
+            for (j, (&other, &other_area)) in bases.iter().zip(&areas).enumerate() {
                 let d = base.distance(other);
                 if j == i || d >= r || d <= 0.0 {
                     continue;
@@ -231,21 +283,27 @@ pub(super) fn set_neighbour_tropisms(garden: &mut Garden) {
                 v += weight * (base - other) / d;
             }
             let v = v.clamp_length_max(1.0);
+            let height = t.tree.metrics().height_m;
             let alpha = (height / expected.height_30y_m.max(0.5))
                 .clamp(0.0, 1.0)
                 .sqrt();
-            glam::Vec3::new(v.x, 0.0, v.y) * (1.0 - alpha)
+            Some(glam::Vec3::new(v.x, 0.0, v.y) * (1.0 - alpha))
         })
         .collect();
     for (t, v) in garden.trees.iter_mut().zip(tropisms) {
-        t.tree.environment.neighbour_tropism = v;
+        if let Some(v) = v {
+            t.tree.environment.neighbour_tropism = v;
+        }
     }
 }
 
-/// What one iteration did to a tree's nodes, in garden space.
+/// What one iteration (or an edit) did to a tree's nodes.
 pub(super) struct NodeChanges {
+    /// Garden space.
     added: Vec<Vec3>,
     removed: Vec<Vec3>,
+    /// The added nodes in the tree's own space (as its grid reads them).
+    added_in_tree: Vec<Vec3>,
 }
 
 impl NodeChanges {
@@ -258,6 +316,7 @@ impl NodeChanges {
         let iteration = t.tree.iteration;
         let nodes = &t.tree.skeleton.internodes;
         let mut added = Vec::new();
+        let mut added_in_tree = Vec::new();
         let mut removed = Vec::new();
         let mut old = before.iter();
         let mut matched = true;
@@ -265,6 +324,7 @@ impl NodeChanges {
             let p = base + n.end;
             if n.born_iteration == iteration {
                 added.push(p);
+                added_in_tree.push(n.end);
                 continue;
             }
             loop {
@@ -285,45 +345,123 @@ impl NodeChanges {
             return NodeChanges {
                 added: nodes.iter().map(|n| base + n.end).collect(),
                 removed: before.to_vec(),
+                added_in_tree: nodes.iter().map(|n| n.end).collect(),
             };
         }
         removed.extend(old.copied());
-        NodeChanges { added, removed }
+        NodeChanges {
+            added,
+            removed,
+            added_in_tree,
+        }
     }
 }
 
 /// Adds the nodes each tree grew to, and takes those it shed from, the shadow grids of the
-/// trees it is linked to.
+/// trees it is linked to (where their covers hold neighbours' shade); then each tree whose new
+/// nodes opened new cells of its cover takes in the shade its neighbours' nodes cast there.
 pub(super) fn hand_on_shade(garden: &mut Garden, changes: &[Option<NodeChanges>]) {
-    garden.trees.par_iter_mut().for_each(|t| {
-        let base = t.base();
-        for &j in &t.neighbours {
-            if let Some(c) = &changes[j as usize] {
-                let shadow = &mut t.tree.environment.shadow;
-                shadow.apply_nodes(c.added.iter().map(|&p| p - base), 1);
-                shadow.apply_nodes(c.removed.iter().map(|&p| p - base), -1);
+    let opens: Vec<bool> = garden
+        .trees
+        .par_iter()
+        .zip(changes)
+        .map(|(t, c)| {
+            let cover = &t.shade_cover;
+            !cover.everywhere
+                && c.as_ref()
+                    .is_some_and(|c| c.added_in_tree.iter().any(|&p| cover.opens(p)))
+        })
+        .collect();
+    let indexes: Vec<NodeIndex> = garden
+        .trees
+        .iter_mut()
+        .map(|t| std::mem::take(&mut t.node_index))
+        .collect();
+    let bases: Vec<Vec3> = garden.trees.iter().map(GardenTree::base).collect();
+    garden
+        .trees
+        .par_iter_mut()
+        .zip(changes)
+        .zip(opens)
+        .for_each(|((t, own), opens)| {
+            let base = t.base();
+            let (shadow, cover) = (&mut t.tree.environment.shadow, &mut t.shade_cover);
+            for &j in &t.neighbours {
+                if let Some(c) = &changes[j as usize] {
+                    let near = |p: &Vec3| cover.covers(*p);
+                    shadow.apply_nodes(c.added.iter().map(|&p| p - base).filter(near), 1);
+                    shadow.apply_nodes(c.removed.iter().map(|&p| p - base).filter(near), -1);
+                }
             }
-        }
-    });
+            let Some(own) = own else { return };
+            let new = cover.extend(own.added_in_tree.iter().copied());
+            if !opens || new.is_empty() {
+                return;
+            }
+            // The neighbours' nodes already standing in the cells just opened.
+            let mut asked = CellSet::default();
+            for c in new.iter() {
+                let (lo, hi) = cover.cell_box(c);
+                asked.add_box(base + lo, base + hi);
+            }
+            let mut cast = Vec::new();
+            for &j in &t.neighbours {
+                let other = bases[j as usize];
+                indexes[j as usize].for_each_in(&asked, |end| {
+                    let p = (other + end) - base;
+                    if cover.in_cells(&new, p) {
+                        cast.push(p);
+                    }
+                });
+            }
+            shadow.apply_nodes(cast, 1);
+        });
+    for (t, index) in garden.trees.iter_mut().zip(indexes) {
+        t.node_index = index;
+    }
 }
 
-/// Each tree's shadow grid rebuilt from its own nodes and its linked neighbours'.
+/// Makes the grid of tree `index` hold every linked neighbour's shade, wherever it falls (an
+/// edited tree may grow anywhere): the neighbours' nodes outside its cover are cast.
+pub(super) fn set_shade_everywhere(garden: &mut Garden, index: usize) {
+    let t = &garden.trees[index];
+    if t.shade_cover.everywhere {
+        return;
+    }
+    let base = t.base();
+    let outside: Vec<Vec3> = t
+        .neighbours
+        .iter()
+        .flat_map(|&j| node_ends(&garden.trees[j as usize]))
+        .map(|p| p - base)
+        .filter(|&p| !t.shade_cover.covers(p))
+        .collect();
+    let t = &mut garden.trees[index];
+    t.tree.environment.shadow.apply_nodes(outside, 1);
+    t.shade_cover.everywhere = true;
+}
+
+/// Each tree's shadow grid rebuilt from its own nodes and its linked neighbours' (those its
+/// cover, made anew from its nodes, holds).
 pub(super) fn rebuild_shade(garden: &mut Garden) {
     let ends: Vec<Vec<Vec3>> = garden.trees.par_iter().map(node_ends).collect();
     let competition = garden.competition;
     garden.trees.par_iter_mut().for_each(|t| {
         t.tree.rebuild_shadow();
         t.tree.environment.neighbour_nodes.clear();
+        t.shade_cover = ShadeCover::of(&t.tree);
+        t.node_index = NodeIndex::default();
         if !competition {
             return;
         }
         let base = t.base();
+        let cover = &t.shade_cover;
         for &j in &t.neighbours {
             if let Some(e) = ends.get(j as usize) {
                 t.tree
                     .environment
                     .shadow
-                    .apply_nodes(e.iter().map(|&p| p - base), 1);
+                    .apply_nodes(e.iter().map(|&p| p - base).filter(|&p| cover.covers(p)), 1);
             }
         }
     });
