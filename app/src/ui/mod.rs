@@ -67,6 +67,8 @@ pub struct UiState {
     pub known_length_m: f64,
     /// The rectangles of the panels drawn over the AR view in the last frame, points.
     pub panel_rects: Vec<egui::Rect>,
+    /// A seek catching up: (frame shown, frame sought).
+    pub seek_progress: Option<(usize, usize)>,
     /// A phone's bottom bar shows the brush sliders and playback (folded away by default).
     pub more_controls: bool,
 }
@@ -90,6 +92,7 @@ impl Default for UiState {
             known_length_m: 1.0,
             panel_rects: Vec::new(),
             more_controls: false,
+            seek_progress: None,
         }
     }
 }
@@ -284,7 +287,12 @@ fn playback_ui(ui: &mut Ui, state: &mut UiState, with_play: bool) {
 
 fn overlays_ui(ui: &mut Ui, state: &UiState, view: egui::Rect) {
     let painter = ui.painter_at(view);
-    let hint = if !state.ground_found {
+    let seeking = state
+        .seek_progress
+        .map(|(shown, sought)| format!("Seeking to frame {sought}: tracking frame {shown}..."));
+    let hint = if let Some(seeking) = seeking.as_deref() {
+        Some(seeking)
+    } else if !state.ground_found {
         Some("Move the phone slowly to find the ground...")
     } else if !state.planted {
         Some("Tap the ground where the tree should stand")
