@@ -166,9 +166,8 @@ fn create_gfx(event_loop: &ActiveEventLoop, size: (u32, u32)) -> anyhow::Result<
     if let Some(srgb) = caps.formats.iter().copied().find(|f| f.is_srgb()) {
         config.format = srgb;
     }
-    // Mailbox shows the newest frame without tearing and never blocks the UI thread waiting for
-    // a vertical blank (FIFO waited about a second per frame on Xvfb, whose fake vblank runs at
-    // 1 Hz); FIFO where the surface offers nothing else.
+    // Mailbox shows the newest frame without tearing and without the UI thread waiting for a
+    // vertical blank; FIFO where the surface offers nothing else.
     config.present_mode = if caps.present_modes.contains(&wgpu::PresentMode::Mailbox) {
         wgpu::PresentMode::Mailbox
     } else {
