@@ -47,6 +47,26 @@ pub struct ViewArgs {
     /// in the session) instead of waiting for the user's tap.
     #[arg(long)]
     pub plant_at_origin: bool,
+    /// Measure this many redraws while the footage plays and the tracker runs, print the
+    /// frame-time report (median and 95th percentile, ms per frame) and close the window.
+    #[arg(long, value_name = "N")]
+    pub frame_report: Option<usize>,
+    /// The window's inner size, logical pixels.
+    #[arg(long, value_name = "WIDTHxHEIGHT", default_value = "1120x720", value_parser = parse_window_size)]
+    pub window_size: (u32, u32),
+}
+
+/// `1280x800` → (1280, 800).
+fn parse_window_size(text: &str) -> Result<(u32, u32), String> {
+    let parsed = text
+        .split_once(['x', 'X'])
+        .and_then(|(w, h)| Some((w.trim().parse::<u32>().ok()?, h.trim().parse::<u32>().ok()?)));
+    match parsed {
+        Some((w, h)) if (64..=16384).contains(&w) && (64..=16384).contains(&h) => Ok((w, h)),
+        _ => Err(format!(
+            "expected WIDTHxHEIGHT in pixels from 64 to 16384, such as 1280x800; got {text:?}"
+        )),
+    }
 }
 
 /// Finds the demo sequence from the current folder or the workspace the binary was built in.
@@ -103,9 +123,7 @@ pub fn demo() -> anyhow::Result<()> {
 /// How the window starts.
 #[derive(Clone, Copy, Debug, Default)]
 struct WindowStart {
-    frame: usize,
-    paused: bool,
-    orbit: bool,
+    window: crate::desktop::WindowOptions,
     plant_at_origin: bool,
 }
 
@@ -116,7 +134,7 @@ fn open_window(sequence: &Path, start: WindowStart) -> anyhow::Result<()> {
     let footage_ref = std::fs::canonicalize(sequence).unwrap_or_else(|_| sequence.to_owned());
     let mut player = crate::player::Player::new(footage, footage_ref)?;
     player.plant_at_origin = start.plant_at_origin;
-    crate::desktop::run_window(player, session_path, start.frame, start.paused, start.orbit)
+    crate::desktop::run_window(player, session_path, start.window)
 }
 
 /// What `sylva view` plays.
@@ -131,6 +149,17 @@ pub enum ViewSource {
 }
 
 impl ViewArgs {
+    /// How the window opens.
+    pub fn window_options(&self) -> crate::desktop::WindowOptions {
+        crate::desktop::WindowOptions {
+            first_frame: self.frame,
+            paused: self.paused,
+            orbit_view: self.orbit,
+            size: self.window_size,
+            frame_report: self.frame_report,
+        }
+    }
+
     /// The source these arguments name (the demo without any), checking that the stream-only
     /// options are given with a stream.
     pub fn source(&self) -> anyhow::Result<ViewSource> {
@@ -178,9 +207,7 @@ pub fn view(args: ViewArgs) -> anyhow::Result<()> {
     open_window(
         &sequence,
         WindowStart {
-            frame: args.frame,
-            paused: args.paused,
-            orbit: args.orbit,
+            window: args.window_options(),
             plant_at_origin: args.plant_at_origin,
         },
     )
@@ -223,7 +250,11 @@ fn open_stream(input: StreamSource, args: &ViewArgs) -> anyhow::Result<()> {
     if let Some(dir) = args.record.as_ref() {
         eprintln!("recording the frames shown into {}", dir.display());
     }
-    crate::desktop::run_window(player, session_path, 0, args.paused, args.orbit)
+    let options = crate::desktop::WindowOptions {
+        first_frame: 0,
+        ..args.window_options()
+    };
+    crate::desktop::run_window(player, session_path, options)
 }
 
 #[cfg(any(target_os = "android", target_os = "ios"))]

@@ -1,5 +1,11 @@
 //! The desktop window (winit + wgpu + egui): plays footage, shows the AR view with the tree and
 //! the UI, and records a session of everything the user does.
+//!
+//! Seeking ahead of what the tracker has seen never freezes the window: recorded footage is
+//! tracked once, in order, so a seek past the last tracked frame fast-forwards to it, showing
+//! the frames on the way (each tracked once; at most [`SEEK_BUDGET`] of them per redraw) with a
+//! progress line, and a seek back jumps at once. `--frame-report N` measures the redraws
+//! ([`crate::frame_report`]).
 
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
@@ -11,6 +17,7 @@ use winit::event::WindowEvent;
 use winit::event_loop::{ActiveEventLoop, EventLoop};
 use winit::window::{Window, WindowId};
 
+use crate::frame_report::{FrameSample, FrameTimes};
 use crate::player::Player;
 use crate::render::resources::letterbox;
 use crate::render::{FrameView, Gpu, Renderer};
@@ -39,6 +46,44 @@ struct DesktopApp {
     started: Instant,
     session_path: PathBuf,
     autosaver: crate::autosave::Autosaver,
+    /// The frame a seek is catching up to (recorded footage).
+    seek_target: Option<usize>,
+    /// Recorded footage is tracked up to this frame (the highest one shown).
+    tracked_until: Option<usize>,
+    frame_times: Option<FrameTimes>,
+    /// Inner size the window opens at, logical pixels.
+    window_size: (u32, u32),
+}
+
+/// How long a redraw may spend catching up a seek before it draws (the window shows the
+/// progress at least this often, and few redraws keep the catching up quick where drawing is
+/// slow, as on a software renderer).
+pub const SEEK_BUDGET: std::time::Duration = std::time::Duration::from_millis(200);
+
+/// How the window opens.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct WindowOptions {
+    /// Recorded footage: the frame to start at (reached by a seek, the window drawing).
+    pub first_frame: usize,
+    pub paused: bool,
+    /// Start in the 3D view outside AR.
+    pub orbit_view: bool,
+    /// Inner size, logical pixels.
+    pub size: (u32, u32),
+    /// Measure this many redraws, print the frame-time report and close.
+    pub frame_report: Option<usize>,
+}
+
+impl Default for WindowOptions {
+    fn default() -> Self {
+        WindowOptions {
+            first_frame: 0,
+            paused: false,
+            orbit_view: false,
+            size: (1120, 720),
+            frame_report: None,
+        }
+    }
 }
 
 /// Opens a window on `player` (recorded footage or a stream); returns an error when no window
@@ -46,15 +91,16 @@ struct DesktopApp {
 pub fn run_window(
     mut player: Player,
     session_path: PathBuf,
-    first_frame: usize,
-    paused: bool,
-    orbit_view: bool,
+    options: WindowOptions,
 ) -> anyhow::Result<()> {
     let event_loop = EventLoop::new().context("cannot connect to a display")?;
     event_loop.set_control_flow(winit::event_loop::ControlFlow::Poll);
-    player.frame = first_frame.min(player.footage.len().saturating_sub(1));
-    player.ui.orbit_view = orbit_view;
-    player.ui.playing = !paused;
+    let first_frame = options
+        .first_frame
+        .min(player.footage.len().saturating_sub(1));
+    player.ui.orbit_view = options.orbit_view;
+    player.ui.playing = !options.paused;
+    let live = player.is_live();
     let autosaver = crate::autosave::Autosaver::new(
         &session_path,
         !player.is_live(),
@@ -72,6 +118,10 @@ pub fn run_window(
         started: Instant::now(),
         session_path,
         autosaver,
+        seek_target: (first_frame > 0 && !live).then_some(first_frame),
+        tracked_until: None,
+        frame_times: options.frame_report.map(FrameTimes::new),
+        window_size: options.size,
     };
     event_loop
         .run_app(&mut app)
@@ -92,10 +142,10 @@ pub fn run_window(
     Ok(())
 }
 
-fn create_gfx(event_loop: &ActiveEventLoop) -> anyhow::Result<Gfx> {
+fn create_gfx(event_loop: &ActiveEventLoop, size: (u32, u32)) -> anyhow::Result<Gfx> {
     let attributes = Window::default_attributes()
         .with_title("Sylva")
-        .with_inner_size(winit::dpi::LogicalSize::new(1120.0, 720.0));
+        .with_inner_size(winit::dpi::LogicalSize::new(size.0, size.1));
     let window = Arc::new(
         event_loop
             .create_window(attributes)
@@ -116,7 +166,13 @@ fn create_gfx(event_loop: &ActiveEventLoop) -> anyhow::Result<Gfx> {
     if let Some(srgb) = caps.formats.iter().copied().find(|f| f.is_srgb()) {
         config.format = srgb;
     }
-    config.present_mode = wgpu::PresentMode::AutoVsync;
+    // Mailbox shows the newest frame without tearing and without the UI thread waiting for a
+    // vertical blank; FIFO where the surface offers nothing else.
+    config.present_mode = if caps.present_modes.contains(&wgpu::PresentMode::Mailbox) {
+        wgpu::PresentMode::Mailbox
+    } else {
+        wgpu::PresentMode::AutoVsync
+    };
     surface.configure(&gpu.device, &config);
     let renderer = Renderer::new(&gpu, config.format);
     let egui_ctx = egui::Context::default();
@@ -146,7 +202,7 @@ impl ApplicationHandler for DesktopApp {
         if self.gfx.is_some() {
             return;
         }
-        match create_gfx(event_loop) {
+        match create_gfx(event_loop, self.window_size) {
             Ok(gfx) => {
                 // A new renderer holds nothing yet.
                 self.gfx = Some(gfx);
@@ -177,6 +233,16 @@ impl ApplicationHandler for DesktopApp {
                     self.error = Some(e);
                     event_loop.exit();
                 }
+                let size = self
+                    .gfx
+                    .as_ref()
+                    .map_or((0, 0), |g| (g.config.width, g.config.height));
+                if let Some(times) = self.frame_times.as_ref().filter(|t| t.is_done()) {
+                    if let Some(report) = times.report(size) {
+                        print!("{report}");
+                    }
+                    event_loop.exit();
+                }
             }
             _ => {}
         }
@@ -196,12 +262,67 @@ impl ApplicationHandler for DesktopApp {
 }
 
 impl DesktopApp {
+    /// Plays the footage to wall-clock time, or catches a seek up (recorded footage).
+    fn update(&mut self) -> anyhow::Result<()> {
+        if self.player.is_live() {
+            return self.player.tick(self.started.elapsed().as_secs_f64());
+        }
+        let tracked = self.tracked_until;
+        if let Some(target) = self
+            .player
+            .ui
+            .seek_to
+            .take_if(|t| tracked.is_none_or(|last| *t > last + 1))
+        {
+            self.seek_target = Some(target);
+        }
+        match self.seek_target {
+            Some(target) => {
+                let started = Instant::now();
+                loop {
+                    let next = match self.tracked_until {
+                        None => 0,
+                        // Frames up to the last tracked one are cached: jump there.
+                        Some(last) if self.player.frame < last => last,
+                        Some(_) => self.player.frame + 1,
+                    };
+                    self.player.show_frame(next.min(target))?;
+                    self.note_tracked();
+                    if self.player.frame >= target || started.elapsed() >= SEEK_BUDGET {
+                        break;
+                    }
+                }
+                if self.player.frame >= target {
+                    self.seek_target = None;
+                }
+            }
+            None => {
+                self.player.tick(self.started.elapsed().as_secs_f64())?;
+                self.note_tracked();
+            }
+        }
+        self.player.ui.seek_progress = self.seek_target.map(|t| (self.player.frame, t));
+        Ok(())
+    }
+
+    fn note_tracked(&mut self) {
+        if self.player.image.is_some() {
+            self.tracked_until = self.tracked_until.max(Some(self.player.frame));
+        }
+    }
+
     fn redraw(&mut self) -> anyhow::Result<()> {
+        let redraw_started = Instant::now();
+        let frame_ms = self
+            .frame_times
+            .as_mut()
+            .map_or(0.0, |t| t.start(redraw_started));
+        let seeking = self.seek_target.is_some();
+        self.update()?;
+        let update_ms = redraw_started.elapsed().as_secs_f32() * 1000.0;
         let Some(gfx) = self.gfx.as_mut() else {
             return Ok(());
         };
-        let elapsed = self.started.elapsed().as_secs_f64();
-        self.player.tick(elapsed)?;
         let frame = match gfx.surface.get_current_texture() {
             wgpu::CurrentSurfaceTexture::Success(t)
             | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
@@ -282,6 +403,7 @@ impl DesktopApp {
                 .render(&gfx.gpu, &mut encoder, &target, size, &view);
         }
         self.player.ui.budget.render_ms = render_started.elapsed().as_secs_f32() * 1000.0;
+        let ui_started = Instant::now();
 
         let raw = gfx.egui_state.take_egui_input(&gfx.window);
         let intrinsics = self.player.footage.intrinsics;
@@ -306,6 +428,8 @@ impl DesktopApp {
             .handle_platform_output(&gfx.window, output.platform_output);
         let ppp = output.pixels_per_point;
         let jobs = gfx.egui_ctx.tessellate(output.shapes, ppp);
+        let ui_ms = ui_started.elapsed().as_secs_f32() * 1000.0;
+        let present_started = Instant::now();
         let screen = egui_wgpu::ScreenDescriptor {
             size_in_pixels: [size.0, size.1],
             pixels_per_point: ppp,
@@ -355,6 +479,17 @@ impl DesktopApp {
             .queue
             .submit(callbacks.into_iter().chain([encoder.finish()]));
         gfx.gpu.queue.present(frame);
+        if let Some(times) = self.frame_times.as_mut() {
+            let sample = FrameSample {
+                frame_ms,
+                update_ms,
+                render_ms: self.player.ui.budget.render_ms,
+                ui_ms,
+                present_ms: present_started.elapsed().as_secs_f32() * 1000.0,
+                seeking,
+            };
+            times.record(sample, self.player.frame);
+        }
         if self.player.ui.export_requested {
             self.player.ui.export_requested = false;
             let path = crate::player::export_tree(&self.player.design, Path::new("out"))?;

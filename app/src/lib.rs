@@ -12,6 +12,7 @@ pub mod cmd_track;
 pub mod demo_script;
 pub mod desktop;
 pub mod footage;
+pub mod frame_report;
 pub mod live;
 #[cfg(not(any(target_os = "android", target_os = "ios")))]
 pub mod live_capture;

@@ -214,6 +214,7 @@ impl Session {
                 } if !(length_m.is_finite() && (0.01..=1000.0).contains(length_m)) => {
                     Some(format!("a known length of {length_m} m"))
                 }
+                InputEvent::Tool { tool } if tool.check().is_err() => tool.check().err(),
                 _ if !timed.time_s.is_finite() => Some("a non-finite time".into()),
                 _ => None,
             };

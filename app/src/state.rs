@@ -16,7 +16,7 @@ use glam::{Affine3A, Quat, Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 use sylva_core::edit::{
     Bend, BendSettings, BrushSettings, BrushStroke, History, OperationKind, PositionalConstraint,
-    StrokeCamera, Timeline, prune_at,
+    StrokeCamera, Timeline,
 };
 use sylva_core::environment::DepthConstraint;
 use sylva_core::environment::{Scene, SceneMode};
@@ -28,6 +28,9 @@ use crate::planting::{SceneChoice, growth_scene, tree_scene};
 use crate::render::{GroundPlane, ViewCamera};
 use crate::scale::{DesignScale, ScaleTool};
 use crate::scene_tracking::SceneOccupancy;
+
+mod tools;
+pub use tools::{DEFAULT_BRANCH_DIAMETER_M, LASSO_MAX_ITERATIONS, Tool};
 
 /// Growth and brush parameters the UI exposes.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
@@ -229,6 +232,10 @@ pub enum InputEvent {
     ScaleTool {
         tool: Option<ScaleTool>,
     },
+    /// Chooses the editing tool one finger uses ([`Tool`]; sessions without one brush).
+    Tool {
+        tool: Tool,
+    },
 }
 
 /// A brush stroke.
@@ -303,6 +310,8 @@ pub struct DesignState {
     /// Bumped whenever the tree changes (the renderer re-meshes on change).
     pub revision: u64,
     grow_debt: f32,
+    /// The editing tool and its gesture in progress.
+    tools: tools::ToolState,
 }
 
 /// Grows `tree` autonomously to iteration `target` (keeping each iteration in `timeline`) against
@@ -378,6 +387,7 @@ impl DesignState {
             time_s: 0.0,
             revision: 0,
             grow_debt: 0.0,
+            tools: Default::default(),
         }
     }
 
@@ -461,6 +471,7 @@ impl DesignState {
                 self.scale.set_holding_height_m(*holding_height_m)
             }
             InputEvent::ScaleTool { tool } => self.scale.choose(*tool),
+            InputEvent::Tool { tool } => self.choose_tool(*tool),
         }
     }
 
@@ -576,6 +587,9 @@ impl DesignState {
         if self.scale.tool.is_some() {
             // A scale tool takes the taps (its touches never reach the tree).
             self.scale.touch(phase, id, pixel);
+            return;
+        }
+        if self.tool_touch(phase, id, pixel) {
             return;
         }
         match phase {
@@ -764,21 +778,7 @@ impl DesignState {
             return;
         }
         self.last_tap = None;
-        let Some(id) = self.pick(pixel) else {
-            return;
-        };
-        let node = self.tree.skeleton.get(id);
-        let point = 0.5 * (node.start + node.end);
-        let pruned = self
-            .history
-            .perform(OperationKind::Prune, &mut self.tree, |tree| {
-                prune_at(tree, point)
-            });
-        if pruned.is_ok() {
-            self.timeline.keep(&self.tree);
-            self.selected = None;
-            self.changed();
-        }
+        self.prune_under(pixel);
     }
 
     fn detect_hold(&mut self) {

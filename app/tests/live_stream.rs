@@ -72,6 +72,8 @@ fn view_args(video: &Path) -> ViewArgs {
         paused: false,
         orbit: false,
         plant_at_origin: false,
+        frame_report: None,
+        window_size: (1120, 720),
     }
 }
 

@@ -66,14 +66,7 @@ fn app() -> App {
         design.advance_frame(Some(camera), step as f64 / 30.0, 1.0 / 30.0);
     }
     assert_eq!(design.num_scene_keyframes(), 1);
-    App {
-        ui: UiState {
-            ground_found: true,
-            planted: true,
-            ..UiState::default()
-        },
-        design,
-    }
+    App::planted(design)
 }
 
 fn harness(app: App) -> Harness<'static, App> {

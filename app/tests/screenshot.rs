@@ -11,8 +11,10 @@
 //! Needs `Xvfb` and ImageMagick's `import` (scripts/setup.sh installs both); fails loudly without.
 //! Set `SYLVA_SCREENSHOT_DIR` to keep the screenshots.
 
+mod xvfb;
+
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+use std::process::{Command, Stdio};
 use std::time::Duration;
 
 use glam::{DAffine3, Vec2, Vec3};
@@ -26,42 +28,8 @@ use sylva_tracking::metrics::{PosePair, align_frames};
 
 const WINDOW: (u32, u32) = (1120, 720);
 
-struct Killed(Child);
-
-impl Drop for Killed {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
-
 fn demo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../test-data/demo_garden")
-}
-
-fn start_xvfb() -> (Killed, String) {
-    let display = format!(":{}", 90 + std::process::id() % 100);
-    let child = Command::new("Xvfb")
-        .args([
-            display.as_str(),
-            "-screen",
-            "0",
-            "1280x800x24",
-            "-nolisten",
-            "tcp",
-        ])
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .expect("Xvfb is required for this test (apt-get install xvfb)");
-    let socket = format!("/tmp/.X11-unix/X{}", &display[1..]);
-    for _ in 0..100 {
-        if Path::new(&socket).exists() {
-            break;
-        }
-        std::thread::sleep(Duration::from_millis(100));
-    }
-    (Killed(child), display)
 }
 
 /// Runs the app paused at `frame` and takes a screenshot once the window shows that frame of the
@@ -89,7 +57,7 @@ fn screenshot(
         .stderr(Stdio::inherit())
         .spawn()
         .expect("start sylva");
-    let _app = Killed(app);
+    let _app = xvfb::Killed(app);
     let path = dir.join(format!("screenshot-{frame}.png"));
     let mut shown = 0.0;
     for _ in 0..SCREENSHOT_TRIES {
@@ -252,7 +220,7 @@ fn under_xvfb_the_window_shows_a_tree_that_stays_on_the_ground_as_the_camera_mov
     };
     std::fs::create_dir_all(&dir).expect("screenshot dir");
     let truth_from_tracked = truth_from_tracked(&footage, 200);
-    let (_xvfb, display) = start_xvfb();
+    let (_xvfb, display) = xvfb::start_xvfb(90);
     let mut eyes = Vec::new();
     for frame in [60, 200] {
         let image = footage.load_rgba(frame).expect("frame image");

@@ -1,7 +1,10 @@
-//! The egui UI, touch first (mouse acts as touch): a side bar with brush radius, grow/ungrow and
-//! undo; a top bar with tabs (the tree: species, age and plain-language crown controls; the
-//! research parameters under "Advanced"; export); the coaching overlay until the ground is found;
-//! the frame-budget overlay; play/pause/seek.
+//! The egui UI, touch first (mouse acts as touch): a side bar with the tools (brush, lasso
+//! crown, width, bend, prune: [`tools_ui`]), brush radius, grow/ungrow and undo; a top bar with
+//! tabs (the tree: species, age and plain-language crown controls; the research parameters under
+//! "Advanced"; export); the coaching overlay until the ground is found; the frame-budget
+//! overlay; play/pause/seek. The panels overlay the AR view (the camera image keeps its place);
+//! on a portrait screen (a phone held upright) the side bar docks at the bottom with the
+//! playback controls, so that no panel covers the middle of the view where the tree stands.
 //!
 //! UI functions never change the design directly: they emit [`InputEvent`]s, which the caller
 //! applies and records, so sessions capture every edit.
@@ -9,6 +12,7 @@
 pub mod orbit;
 pub mod plain;
 pub mod scale_ui;
+pub mod tools_ui;
 pub mod touch;
 pub mod widgets;
 
@@ -61,6 +65,12 @@ pub struct UiState {
     pub species_names: Vec<String>,
     /// The length the "Known length" tool marks, metres.
     pub known_length_m: f64,
+    /// The rectangles of the panels drawn over the AR view in the last frame, points.
+    pub panel_rects: Vec<egui::Rect>,
+    /// A seek catching up: (frame shown, frame sought).
+    pub seek_progress: Option<(usize, usize)>,
+    /// A phone's bottom bar shows the brush sliders and playback (folded away by default).
+    pub more_controls: bool,
 }
 
 impl Default for UiState {
@@ -80,6 +90,9 @@ impl Default for UiState {
             export_requested: false,
             species_names: crate::state::species_names(),
             known_length_m: 1.0,
+            panel_rects: Vec::new(),
+            more_controls: false,
+            seek_progress: None,
         }
     }
 }
@@ -93,7 +106,9 @@ pub fn sylva_ui(
     events: &mut Vec<InputEvent>,
 ) -> egui::Rect {
     let mut params = design.params.clone();
-    egui::Panel::top("sylva top bar").show(ui, |ui| {
+    let portrait = is_portrait(ui.max_rect().size());
+    state.panel_rects.clear();
+    let top = egui::Panel::top("sylva top bar").show(ui, |ui| {
         ui.horizontal(|ui| {
             for (tab, name) in [
                 (Tab::Tree, "Tree"),
@@ -125,16 +140,47 @@ pub fn sylva_ui(
             }
         }
     });
-    egui::Panel::right("sylva side bar")
-        .exact_size(120.0)
-        .show(ui, |ui| {
-            side_bar_ui(ui, &mut params, design, events);
+    state.panel_rects.push(top.response.rect);
+    if portrait {
+        // Docked at the bottom, the secondary controls folded away until asked for.
+        let bottom = egui::Panel::bottom("sylva phone bar").show(ui, |ui| {
+            tools_ui::tool_selector_ui(ui, design, false, events);
+            ui.horizontal_wrapped(|ui| {
+                grow_buttons_ui(ui, design, events);
+                play_button_ui(ui, state);
+                let more = if state.more_controls { "Less" } else { "More" };
+                if ui.add(egui::Button::new(more).min_size(FINGER)).clicked() {
+                    state.more_controls = !state.more_controls;
+                }
+            });
+            if state.more_controls {
+                ui.horizontal_wrapped(|ui| brush_sliders_ui(ui, &mut params, false));
+                playback_ui(ui, state, false);
+            }
         });
-    egui::Panel::bottom("sylva playback").show(ui, |ui| playback_ui(ui, state));
+        state.panel_rects.push(bottom.response.rect);
+    } else {
+        let side = egui::Panel::right("sylva side bar")
+            .exact_size(SIDE_BAR_WIDTH_PT)
+            .show(ui, |ui| {
+                ui.vertical_centered(|ui| {
+                    ui.label("Tools");
+                    tools_ui::tool_selector_ui(ui, design, true, events);
+                    ui.separator();
+                    brush_sliders_ui(ui, &mut params, true);
+                    grow_buttons_ui(ui, design, events);
+                });
+            });
+        state.panel_rects.push(side.response.rect);
+        let bottom =
+            egui::Panel::bottom("sylva playback").show(ui, |ui| playback_ui(ui, state, true));
+        state.panel_rects.push(bottom.response.rect);
+    }
     if params != design.params {
         events.push(InputEvent::Parameters { parameters: params });
     }
     let view = ui.available_rect_before_wrap();
+    tools_ui::tool_overlays_ui(ui, design, view);
     overlays_ui(ui, state, view);
     scale_ui::overlay_ui(ui, design, view);
     scale_ui::status_line_ui(ui, design, view);
@@ -152,48 +198,75 @@ pub(crate) fn season_ui(ui: &mut Ui, season: &mut Season) {
     });
 }
 
-fn side_bar_ui(
-    ui: &mut Ui,
-    params: &mut crate::state::Parameters,
-    design: &DesignState,
-    events: &mut Vec<InputEvent>,
-) {
-    ui.vertical_centered(|ui| {
-        ui.label("Brush");
-        ui.add(
-            egui::Slider::new(&mut params.brush_radius, 0.02..=0.5)
-                .vertical()
-                .text("Brush radius"),
-        );
-        ui.separator();
-        ui.label("Grow (up) / ungrow (down)");
-        ui.add(
-            egui::Slider::new(&mut params.grow_speed, -20.0..=20.0)
-                .vertical()
-                .text("Grow speed"),
-        );
-        if ui.button("Grow").clicked() {
-            events.push(InputEvent::Grow { iterations: 1 });
-        }
-        if ui.button("Ungrow").clicked() {
-            events.push(InputEvent::Grow { iterations: -1 });
-        }
-        ui.separator();
-        let undo = ui.add_enabled(
-            design.undo_depth() > 0,
-            egui::Button::new(RichText::new("Undo").size(18.0)),
-        );
-        if undo.clicked() {
-            events.push(InputEvent::Undo);
-        }
-    });
+/// Width of the side bar on landscape screens, points.
+pub const SIDE_BAR_WIDTH_PT: f32 = 120.0;
+
+/// Whether a screen of `size` points is held upright (or too narrow for a side bar): the
+/// controls then dock at the bottom.
+pub fn is_portrait(size: egui::Vec2) -> bool {
+    size.x < size.y || size.x < 5.0 * SIDE_BAR_WIDTH_PT
 }
 
-fn playback_ui(ui: &mut Ui, state: &mut UiState) {
-    ui.horizontal(|ui| {
-        let label = if state.playing { "Pause" } else { "Play" };
-        if ui.button(label).clicked() {
-            state.playing = !state.playing;
+/// A fingertip-tall button.
+const FINGER: egui::Vec2 = egui::vec2(0.0, 0.75 * tools_ui::TOOL_BUTTON_SIZE_PT);
+
+/// Brush radius and grow speed: `vertical` sliders in the side bar, horizontal ones in a
+/// phone's bottom bar.
+fn brush_sliders_ui(ui: &mut Ui, params: &mut crate::state::Parameters, vertical: bool) {
+    fn slider(slider: egui::Slider<'_>, vertical: bool) -> egui::Slider<'_> {
+        if vertical { slider.vertical() } else { slider }
+    }
+    if vertical {
+        ui.spacing_mut().slider_width = 80.0;
+        ui.label("Brush size");
+    }
+    ui.add(slider(
+        egui::Slider::new(&mut params.brush_radius, 0.02..=0.5).text("Brush radius"),
+        vertical,
+    ));
+    if vertical {
+        ui.separator();
+        ui.label("Grow (up) / ungrow (down)");
+    }
+    ui.add(slider(
+        egui::Slider::new(&mut params.grow_speed, -20.0..=20.0).text("Grow speed"),
+        vertical,
+    ));
+}
+
+/// Grow, ungrow and undo.
+fn grow_buttons_ui(ui: &mut Ui, design: &DesignState, events: &mut Vec<InputEvent>) {
+    if ui.add(egui::Button::new("Grow").min_size(FINGER)).clicked() {
+        events.push(InputEvent::Grow { iterations: 1 });
+    }
+    if ui
+        .add(egui::Button::new("Ungrow").min_size(FINGER))
+        .clicked()
+    {
+        events.push(InputEvent::Grow { iterations: -1 });
+    }
+    let undo = ui.add_enabled(
+        design.undo_depth() > 0,
+        egui::Button::new(RichText::new("Undo").size(18.0)).min_size(FINGER),
+    );
+    if undo.clicked() {
+        events.push(InputEvent::Undo);
+    }
+}
+
+fn play_button_ui(ui: &mut Ui, state: &mut UiState) {
+    let label = if state.playing { "Pause" } else { "Play" };
+    if ui.add(egui::Button::new(label).min_size(FINGER)).clicked() {
+        state.playing = !state.playing;
+    }
+}
+
+/// Play/pause (unless `with_play` is false: a phone's bar has it already), the frame slider and
+/// the view switches.
+fn playback_ui(ui: &mut Ui, state: &mut UiState, with_play: bool) {
+    ui.horizontal_wrapped(|ui| {
+        if with_play {
+            play_button_ui(ui, state);
         }
         if state.live {
             ui.label(format!("Frame {} (live)", state.frame));
@@ -214,7 +287,12 @@ fn playback_ui(ui: &mut Ui, state: &mut UiState) {
 
 fn overlays_ui(ui: &mut Ui, state: &UiState, view: egui::Rect) {
     let painter = ui.painter_at(view);
-    let hint = if !state.ground_found {
+    let seeking = state
+        .seek_progress
+        .map(|(shown, sought)| format!("Seeking to frame {sought}: tracking frame {shown}..."));
+    let hint = if let Some(seeking) = seeking.as_deref() {
+        Some(seeking)
+    } else if !state.ground_found {
         Some("Move the phone slowly to find the ground...")
     } else if !state.planted {
         Some("Tap the ground where the tree should stand")
@@ -240,11 +318,12 @@ fn overlays_ui(ui: &mut Ui, state: &UiState, view: egui::Rect) {
         "tracking {:.1} ms · growth {:.1} ms · meshing {:.1} ms · render {:.1} ms",
         b.tracking_ms, b.growth_ms, b.meshing_ms, b.render_ms
     );
-    painter.text(
-        view.left_bottom() + egui::vec2(8.0, -8.0),
-        Align2::LEFT_BOTTOM,
-        text,
-        egui::FontId::monospace(12.0),
-        Color32::from_rgb(255, 255, 180),
+    // Light text on a dark plate: readable over paving and lawn alike.
+    let galley = painter.layout_no_wrap(text, egui::FontId::monospace(13.0), Color32::WHITE);
+    let plate = Align2::LEFT_BOTTOM.anchor_size(
+        view.left_bottom() + egui::vec2(6.0, -6.0),
+        galley.size() + egui::vec2(8.0, 4.0),
     );
+    painter.rect_filled(plate, 4.0, Color32::from_black_alpha(170));
+    painter.galley(plate.min + egui::vec2(4.0, 2.0), galley, Color32::WHITE);
 }

@@ -22,6 +22,22 @@ pub fn image_from_window(
     )
 }
 
+/// Where camera-image pixel `pixel` is drawn in the window, points (the inverse of
+/// [`image_from_window`]).
+pub fn window_from_image(
+    pixel: glam::Vec2,
+    pixels_per_point: f32,
+    target: (u32, u32),
+    k: &Intrinsics,
+) -> Pos2 {
+    let region = letterbox(target, k);
+    let px = glam::Vec2::new(
+        region[0] + pixel.x / k.width as f32 * region[2],
+        region[1] + pixel.y / k.height as f32 * region[3],
+    );
+    Pos2::new(px.x / pixels_per_point, px.y / pixels_per_point)
+}
+
 /// Emits touch events for pointer and touch input inside `view` (not over the panels).
 pub fn view_touches_ui(
     ui: &mut Ui,
@@ -76,5 +92,25 @@ pub fn view_touches_ui(
         && (response.drag_stopped() || response.clicked())
     {
         events.push(to_event(TouchPhase::End, 0, pos));
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn window_from_image_undoes_image_from_window_in_a_letterboxed_portrait_window() {
+        let k = Intrinsics::from_fov(640, 480, 1.0);
+        let target = (1080, 2340);
+        for pixel in [
+            glam::Vec2::new(0.0, 0.0),
+            glam::Vec2::new(320.0, 240.0),
+            glam::Vec2::new(600.0, 17.0),
+        ] {
+            let pos = window_from_image(pixel, 3.0, target, &k);
+            let back = image_from_window(pos, 3.0, target, &k);
+            assert!(back.distance(pixel) < 1e-3, "{pixel} -> {pos:?} -> {back}");
+        }
     }
 }
