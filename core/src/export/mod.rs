@@ -12,7 +12,9 @@
 //! as `COLOR_0`. OBJ: the finest level only, textures written next to it.
 
 mod glb;
+mod leaf_instances;
 mod obj;
+mod quantize;
 
 use std::path::{Path, PathBuf};
 

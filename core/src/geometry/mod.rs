@@ -34,11 +34,13 @@ pub mod crown;
 mod lanes;
 pub mod leaf_card;
 pub mod leaves;
+mod lod_leaves;
 mod looks;
 mod mesher;
 mod parent_tube;
 mod petiole;
 mod rings;
+pub mod silhouette;
 pub mod synthetic;
 pub mod textures;
 pub mod topology;
@@ -64,6 +66,15 @@ pub type AmbientFn<'a> = &'a dyn Fn(Vec3) -> f32;
 /// Fractions of the full triangle count aimed at by the three levels of detail.
 pub const LOD_TRIANGLE_FRACTIONS: [f32; 3] = [1.0, 0.4, 0.15];
 
+/// Default of [`MeshParams::ring_tolerance`]: a joint off the straight line by less than a
+/// quarter of the branch's radius gets no ring of its own (the bark's outline moves by at most
+/// that, under a pixel until the branch is a few pixels wide).
+pub const RING_TOLERANCE: f32 = 0.25;
+
+/// Default of [`MeshParams::ring_tolerance_m`]: 4 mm, under one pixel of a 10 m tree seen whole
+/// on a screen 2,160 pixels high.
+pub const RING_TOLERANCE_M: f32 = 0.004;
+
 /// Parameters of the tree mesh. Lengths in metres.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct MeshParams {
@@ -74,6 +85,17 @@ pub struct MeshParams {
     /// twig 3 sides instead of 7 and a trunk its 16, which takes a 40-year willow's bark from
     /// 1.0M to 0.54M triangles.
     pub side_exponent: f32,
+    /// Largest distance, relative to the branch's radius there, by which a joint's centre may
+    /// stand off the straight line between the rings kept around it for its ring to be left
+    /// out: nearly straight runs of a branch get one segment instead of one per internode. A
+    /// ring where a visible branch grows out, a chain's first two rings and its tip are always
+    /// kept. 0 keeps every ring (files written before this parameter).
+    #[serde(default)]
+    pub ring_tolerance: f32,
+    /// The same distance in metres, for the thinnest twigs, whose radius is a few millimetres
+    /// (the larger of the two applies). 0 in files written before this parameter.
+    #[serde(default)]
+    pub ring_tolerance_m: f32,
     /// Side length of one square bark texture tile on a thick branch.
     pub bark_tile_size: f32,
     /// Largest rotation of the bark texture from one segment to the next, in turns.
@@ -101,6 +123,8 @@ impl Default for MeshParams {
         MeshParams {
             max_sides: 16,
             side_exponent: 1.4,
+            ring_tolerance: RING_TOLERANCE,
+            ring_tolerance_m: RING_TOLERANCE_M,
             bark_tile_size: 0.25,
             bark_twist: 0.02,
             tip_taper: 0.5,
