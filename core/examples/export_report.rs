@@ -9,6 +9,7 @@
 use sylva_core::Tree;
 use sylva_core::export::glb_bytes;
 use sylva_core::geometry::build_tree_meshes;
+use sylva_core::geometry::silhouette::side_silhouette_difference;
 use sylva_core::species::Species;
 
 fn main() {
@@ -45,8 +46,10 @@ fn main() {
             }
         }
         let bytes = glb.len() as f64 * 1e-6;
+        let silhouette = side_silhouette_difference(&meshes, coarsest)
+            .map_or("-".to_string(), |d| format!("{:.1}%", 100.0 * d));
         println!(
-            "{:<16} {:>8.2} {:>10} {:>10} {:>10} {:>9} {:>8.1}% {:>9}",
+            "{:<16} {:>8.2} {:>10} {:>10} {:>10} {:>9} {:>8.1}% {:>10}",
             name,
             bytes,
             total,
@@ -54,7 +57,7 @@ fn main() {
             instanced,
             finest.num_leaf_indices / 6,
             100.0 * ratio,
-            "-",
+            silhouette,
         );
         for lod in &meshes.lods {
             println!(

@@ -6,8 +6,8 @@ use std::path::Path;
 use gltf_json as json;
 use json::validation::{Checked::Valid, USize64};
 
-use super::leaf_instances::{CardInstance, CardKind, card_corners, card_instances, common_scale};
-use super::quantize::{self, Quantizer, UvBox, snorm16, snorm16_up};
+use super::leaf_instances::{CardKind, EXT_MESH_GPU_INSTANCING, card_instances, common_scale};
+use super::quantize::{self, Quantizer, UvBox};
 use super::{ExportError, TEXTURE_SIZE, ambient_color};
 use crate::geometry::leaf_card::card_texture;
 use crate::geometry::textures::{bark_texture, png_bytes};
@@ -19,8 +19,6 @@ const MSFT_LOD: &str = "MSFT_lod";
 const KHR_MESH_QUANTIZATION: &str = "KHR_mesh_quantization";
 /// The glTF extension mapping quantized texture coordinates back to the texture's.
 const KHR_TEXTURE_TRANSFORM: &str = "KHR_texture_transform";
-/// The glTF extension drawing a node's mesh once per instance transform.
-const EXT_MESH_GPU_INSTANCING: &str = "EXT_mesh_gpu_instancing";
 
 const GLB_MAGIC: u32 = 0x4654_6C67; // "glTF"
 const CHUNK_JSON: u32 = 0x4E4F_534A;
@@ -100,8 +98,8 @@ fn chunks(indices: &[u32], num_indices: usize) -> Vec<Chunk> {
     out
 }
 
-struct Builder<'a> {
-    root: json::Root,
+pub(super) struct Builder<'a> {
+    pub(super) root: json::Root,
     bin: Vec<u8>,
     path: &'a Path,
 }
@@ -109,7 +107,7 @@ struct Builder<'a> {
 impl<'a> Builder<'a> {
     /// A buffer view of `bytes`; vertex attribute views carry their element size as stride, since
     /// the primitives drawing parts of them share them.
-    fn view(
+    pub(super) fn view(
         &mut self,
         bytes: &[u8],
         target: Option<json::buffer::Target>,
@@ -133,7 +131,7 @@ impl<'a> Builder<'a> {
     }
 
     #[allow(clippy::too_many_arguments)]
-    fn accessor(
+    pub(super) fn accessor(
         &mut self,
         view: json::Index<json::buffer::View>,
         byte_offset: usize,
@@ -230,13 +228,29 @@ impl<'a> Builder<'a> {
         num_indices: usize,
         material: json::Index<json::Material>,
     ) -> Vec<json::mesh::Primitive> {
-        use json::accessor::ComponentType::{I8, I16, U8, U16};
+        use json::accessor::ComponentType::{I8, I16, U8, U16, U32};
         use json::accessor::Type::{Scalar, Vec2, Vec3, Vec4};
         let runs = chunks(&mesh.indices, num_indices);
+        // Each run's indices relative to its first vertex, as 16-bit integers; a run that
+        // reaches further (a single triangle spanning 2¹⁶ vertices, which no tree mesh has)
+        // as 32-bit ones, aligned to 4 bytes.
         let mut index_bytes = Vec::with_capacity(2 * num_indices);
+        let mut index_starts = Vec::with_capacity(runs.len());
         for run in &runs {
+            let wide = run.last_vertex - run.first_vertex >= u32::from(u16::MAX);
+            if wide {
+                while !index_bytes.len().is_multiple_of(4) {
+                    index_bytes.push(0);
+                }
+            }
+            index_starts.push((index_bytes.len(), if wide { U32 } else { U16 }));
             for &i in &mesh.indices[run.first_index..run.end_index] {
-                index_bytes.extend_from_slice(&((i - run.first_vertex) as u16).to_le_bytes());
+                let relative = i - run.first_vertex;
+                if wide {
+                    index_bytes.extend_from_slice(&relative.to_le_bytes());
+                } else {
+                    index_bytes.extend_from_slice(&(relative as u16).to_le_bytes());
+                }
             }
         }
         let index_view = self.view(
@@ -245,7 +259,7 @@ impl<'a> Builder<'a> {
             None,
         );
         let mut out = Vec::with_capacity(runs.len());
-        for run in runs {
+        for (run, (index_offset, index_component)) in runs.into_iter().zip(index_starts) {
             let (first, count) = (
                 run.first_vertex as usize,
                 (run.last_vertex - run.first_vertex) as usize + 1,
@@ -281,9 +295,9 @@ impl<'a> Builder<'a> {
             attributes.insert(Valid(json::mesh::Semantic::Colors(0)), color);
             let indices = self.accessor(
                 index_view,
-                2 * run.first_index,
+                index_offset,
                 run.end_index - run.first_index,
-                U16,
+                index_component,
                 Scalar,
                 false,
                 None,
@@ -399,157 +413,8 @@ impl<'a> Builder<'a> {
     }
 }
 
-fn f32_bytes<'a>(values: impl Iterator<Item = &'a f32>) -> Vec<u8> {
+pub(super) fn f32_bytes<'a>(values: impl Iterator<Item = &'a f32>) -> Vec<u8> {
     values.flat_map(|v| v.to_le_bytes()).collect()
-}
-
-impl Builder<'_> {
-    /// The card mesh of `kind`'s cards: one quad of `size` (width, length) in card space, of
-    /// the colour of its ambient level, with the leaf material.
-    /// With `baked_scale`, the quad is scaled by it (the instances then carry no scale).
-    fn card_mesh(
-        &mut self,
-        kind: CardKind,
-        size: (f32, f32),
-        baked_scale: Option<glam::Vec3>,
-        material: json::Index<json::Material>,
-    ) -> json::Index<json::Mesh> {
-        use json::accessor::ComponentType::{F32, U8, U16};
-        use json::accessor::Type::{Scalar, Vec2, Vec3, Vec4};
-        use json::buffer::Target::{ArrayBuffer, ElementArrayBuffer};
-        let mut corners = card_corners(size);
-        if let Some(scale) = baked_scale {
-            for (p, _) in &mut corners {
-                *p = (glam::Vec3::from(*p) * scale).to_array();
-            }
-        }
-        let normal_z = if kind.normal_up { 1.0 } else { -1.0 };
-        let positions = f32_bytes(corners.iter().flat_map(|(p, _)| p));
-        let normals = f32_bytes([0.0, 0.0, normal_z].iter().cycle().take(12));
-        let uvs = f32_bytes(corners.iter().flat_map(|(_, uv)| uv));
-        let c = quantize::unorm8(ambient_color(kind.ambient()));
-        let colors = [c, c, c, 255].repeat(4);
-        let indices: Vec<u8> = [0u16, 2, 3, 0, 3, 1]
-            .iter()
-            .flat_map(|i| i.to_le_bytes())
-            .collect();
-        let (lo, hi) = (corners[0].0, corners[3].0);
-        let view = self.view(&positions, Some(ArrayBuffer), Some(12));
-        let position = self.accessor(
-            view,
-            0,
-            4,
-            F32,
-            Vec3,
-            false,
-            Some((lo.to_vec(), hi.to_vec())),
-        );
-        let view = self.view(&normals, Some(ArrayBuffer), Some(12));
-        let normal = self.accessor(view, 0, 4, F32, Vec3, false, None);
-        let view = self.view(&uvs, Some(ArrayBuffer), Some(8));
-        let uv = self.accessor(view, 0, 4, F32, Vec2, false, None);
-        let view = self.view(&colors, Some(ArrayBuffer), Some(4));
-        let color = self.accessor(view, 0, 4, U8, Vec4, true, None);
-        let view = self.view(&indices, Some(ElementArrayBuffer), None);
-        let index = self.accessor(view, 0, 6, U16, Scalar, false, None);
-        let mut attributes = std::collections::BTreeMap::new();
-        attributes.insert(Valid(json::mesh::Semantic::Positions), position);
-        attributes.insert(Valid(json::mesh::Semantic::Normals), normal);
-        attributes.insert(Valid(json::mesh::Semantic::TexCoords(0)), uv);
-        attributes.insert(Valid(json::mesh::Semantic::Colors(0)), color);
-        self.root.push(json::Mesh {
-            extensions: None,
-            extras: Default::default(),
-            name: Some(format!(
-                "leaf_card_ambient{}_{}",
-                kind.ambient_level,
-                if kind.normal_up { "up" } else { "down" }
-            )),
-            primitives: vec![json::mesh::Primitive {
-                attributes,
-                extensions: None,
-                extras: Default::default(),
-                indices: Some(index),
-                material: Some(material),
-                mode: Valid(json::mesh::Mode::Triangles),
-                targets: None,
-            }],
-            weights: None,
-        })
-    }
-
-    /// A node drawing `mesh` once per instance (`EXT_mesh_gpu_instancing`), the instances'
-    /// translations, rotations and scales as normalized signed shorts (`KHR_mesh_quantization`);
-    /// scales above 1 in node space (a tree under a metre across) as floats, and none
-    /// `with_scale` false (the mesh holds the one scale of all of them).
-    fn instance_node(
-        &mut self,
-        name: String,
-        mesh: json::Index<json::Mesh>,
-        instances: &[CardInstance],
-        with_scale: bool,
-    ) -> json::Index<json::Node> {
-        use json::accessor::ComponentType::{F32, I16};
-        use json::accessor::Type::{Vec3, Vec4};
-        let count = instances.len();
-        let padded = |v: glam::Vec3| [snorm16(v.x), snorm16(v.y), snorm16(v.z), 0];
-        // Heights round up, so that no card quantized below the ground sinks into it.
-        let raised = |v: glam::Vec3| [snorm16(v.x), snorm16_up(v.y), snorm16(v.z), 0];
-        let bytes: Vec<u8> = instances
-            .iter()
-            .flat_map(|i| raised(i.translation))
-            .flat_map(|c| c.to_le_bytes())
-            .collect();
-        let view = self.view(&bytes, None, Some(8));
-        let translation = self.accessor(view, 0, count, I16, Vec3, true, None);
-        let bytes: Vec<u8> = instances
-            .iter()
-            .flat_map(|i| i.rotation.to_array().map(snorm16))
-            .flat_map(|c| c.to_le_bytes())
-            .collect();
-        let view = self.view(&bytes, None, None);
-        let rotation = self.accessor(view, 0, count, I16, Vec4, true, None);
-        let fits = instances.iter().all(|i| i.scale.max_element() <= 1.0);
-        let scale = if !with_scale {
-            None
-        } else if fits {
-            let bytes: Vec<u8> = instances
-                .iter()
-                .flat_map(|i| padded(i.scale))
-                .flat_map(|c| c.to_le_bytes())
-                .collect();
-            let view = self.view(&bytes, None, Some(8));
-            Some(self.accessor(view, 0, count, I16, Vec3, true, None))
-        } else {
-            let bytes = f32_bytes(
-                instances
-                    .iter()
-                    .flat_map(|i| i.scale.to_array())
-                    .collect::<Vec<_>>()
-                    .iter(),
-            );
-            let view = self.view(&bytes, None, None);
-            Some(self.accessor(view, 0, count, F32, Vec3, false, None))
-        };
-        let mut attributes = serde_json::json!({
-            "TRANSLATION": translation.value(),
-            "ROTATION": rotation.value(),
-        });
-        if let Some(scale) = scale {
-            attributes["SCALE"] = scale.value().into();
-        }
-        let mut others = serde_json::Map::new();
-        others.insert(
-            EXT_MESH_GPU_INSTANCING.into(),
-            serde_json::json!({ "attributes": attributes }),
-        );
-        self.root.push(json::Node {
-            mesh: Some(mesh),
-            name: Some(name),
-            extensions: Some(json::extensions::scene::Node { others }),
-            ..Default::default()
-        })
-    }
 }
 
 fn build(meshes: &TreeMeshes, path: &Path) -> Result<Vec<u8>, ExportError> {
@@ -748,4 +613,40 @@ fn container(mut json_bytes: Vec<u8>, bin: Vec<u8>, path: &Path) -> Result<Vec<u
     out.extend_from_slice(&CHUNK_BIN.to_le_bytes());
     out.extend_from_slice(&bin);
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn index_runs_stay_within_16_bits_and_cover_every_triangle() {
+        // Three "chains" of 40,000 vertices each, one quad strip per chain.
+        let mut indices = Vec::new();
+        for chain in 0..3u32 {
+            let base = chain * 40_000;
+            for k in 0..19_999 {
+                let (a, b) = (base + 2 * k, base + 2 * k + 2);
+                indices.extend_from_slice(&[a, a + 1, b + 1, a, b + 1, b]);
+            }
+        }
+        let runs = chunks(&indices, indices.len());
+        assert!(runs.len() >= 2, "{runs:?}");
+        assert_eq!(runs[0].first_index, 0);
+        assert_eq!(runs.last().map(|r| r.end_index), Some(indices.len()));
+        for pair in runs.windows(2) {
+            assert_eq!(pair[0].end_index, pair[1].first_index);
+        }
+        for run in &runs {
+            assert!(
+                run.last_vertex - run.first_vertex < u32::from(u16::MAX),
+                "{run:?}"
+            );
+            let used = &indices[run.first_index..run.end_index];
+            assert!(
+                used.iter()
+                    .all(|&i| (run.first_vertex..=run.last_vertex).contains(&i))
+            );
+        }
+    }
 }

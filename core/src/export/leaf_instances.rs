@@ -9,9 +9,16 @@
 //! points along −z or +z of card space, and each side has its own card meshes too.
 
 use glam::{Mat3, Quat, Vec3};
+use gltf_json as json;
+use json::validation::Checked::Valid;
 
-use super::quantize::Quantizer;
+use super::ambient_color;
+use super::glb::{Builder, f32_bytes};
+use super::quantize::{self, Quantizer, snorm16, snorm16_up};
 use crate::geometry::TreeMesh;
+
+/// The glTF extension drawing a node's mesh once per instance transform.
+pub(super) const EXT_MESH_GPU_INSTANCING: &str = "EXT_mesh_gpu_instancing";
 
 /// Levels of the baked ambient light of the leaf cards: steps of 1/15 of the range.
 pub(super) const AMBIENT_LEVELS: usize = 16;
@@ -122,6 +129,155 @@ pub(super) fn card_corners((width_m, length_m): (f32, f32)) -> [([f32; 3], [f32;
         ([-half, length_m, 0.0], [0.0, 0.0]),
         ([half, length_m, 0.0], [1.0, 0.0]),
     ]
+}
+
+impl Builder<'_> {
+    /// The card mesh of `kind`'s cards: one quad of `size` (width, length) in card space, of
+    /// the colour of its ambient level, with the leaf material.
+    /// With `baked_scale`, the quad is scaled by it (the instances then carry no scale).
+    pub(super) fn card_mesh(
+        &mut self,
+        kind: CardKind,
+        size: (f32, f32),
+        baked_scale: Option<glam::Vec3>,
+        material: json::Index<json::Material>,
+    ) -> json::Index<json::Mesh> {
+        use json::accessor::ComponentType::{F32, U8, U16};
+        use json::accessor::Type::{Scalar, Vec2, Vec3, Vec4};
+        use json::buffer::Target::{ArrayBuffer, ElementArrayBuffer};
+        let mut corners = card_corners(size);
+        if let Some(scale) = baked_scale {
+            for (p, _) in &mut corners {
+                *p = (glam::Vec3::from(*p) * scale).to_array();
+            }
+        }
+        let normal_z = if kind.normal_up { 1.0 } else { -1.0 };
+        let positions = f32_bytes(corners.iter().flat_map(|(p, _)| p));
+        let normals = f32_bytes([0.0, 0.0, normal_z].iter().cycle().take(12));
+        let uvs = f32_bytes(corners.iter().flat_map(|(_, uv)| uv));
+        let c = quantize::unorm8(ambient_color(kind.ambient()));
+        let colors = [c, c, c, 255].repeat(4);
+        let indices: Vec<u8> = [0u16, 2, 3, 0, 3, 1]
+            .iter()
+            .flat_map(|i| i.to_le_bytes())
+            .collect();
+        let (lo, hi) = (corners[0].0, corners[3].0);
+        let view = self.view(&positions, Some(ArrayBuffer), Some(12));
+        let position = self.accessor(
+            view,
+            0,
+            4,
+            F32,
+            Vec3,
+            false,
+            Some((lo.to_vec(), hi.to_vec())),
+        );
+        let view = self.view(&normals, Some(ArrayBuffer), Some(12));
+        let normal = self.accessor(view, 0, 4, F32, Vec3, false, None);
+        let view = self.view(&uvs, Some(ArrayBuffer), Some(8));
+        let uv = self.accessor(view, 0, 4, F32, Vec2, false, None);
+        let view = self.view(&colors, Some(ArrayBuffer), Some(4));
+        let color = self.accessor(view, 0, 4, U8, Vec4, true, None);
+        let view = self.view(&indices, Some(ElementArrayBuffer), None);
+        let index = self.accessor(view, 0, 6, U16, Scalar, false, None);
+        let mut attributes = std::collections::BTreeMap::new();
+        attributes.insert(Valid(json::mesh::Semantic::Positions), position);
+        attributes.insert(Valid(json::mesh::Semantic::Normals), normal);
+        attributes.insert(Valid(json::mesh::Semantic::TexCoords(0)), uv);
+        attributes.insert(Valid(json::mesh::Semantic::Colors(0)), color);
+        self.root.push(json::Mesh {
+            extensions: None,
+            extras: Default::default(),
+            name: Some(format!(
+                "leaf_card_ambient{}_{}",
+                kind.ambient_level,
+                if kind.normal_up { "up" } else { "down" }
+            )),
+            primitives: vec![json::mesh::Primitive {
+                attributes,
+                extensions: None,
+                extras: Default::default(),
+                indices: Some(index),
+                material: Some(material),
+                mode: Valid(json::mesh::Mode::Triangles),
+                targets: None,
+            }],
+            weights: None,
+        })
+    }
+
+    /// A node drawing `mesh` once per instance (`EXT_mesh_gpu_instancing`), the instances'
+    /// translations, rotations and scales as normalized signed shorts (`KHR_mesh_quantization`);
+    /// scales above 1 in node space (a tree under a metre across) as floats, and none
+    /// `with_scale` false (the mesh holds the one scale of all of them).
+    pub(super) fn instance_node(
+        &mut self,
+        name: String,
+        mesh: json::Index<json::Mesh>,
+        instances: &[CardInstance],
+        with_scale: bool,
+    ) -> json::Index<json::Node> {
+        use json::accessor::ComponentType::{F32, I16};
+        use json::accessor::Type::{Vec3, Vec4};
+        let count = instances.len();
+        let padded = |v: glam::Vec3| [snorm16(v.x), snorm16(v.y), snorm16(v.z), 0];
+        // Heights round up, so that no card quantized below the ground sinks into it.
+        let raised = |v: glam::Vec3| [snorm16(v.x), snorm16_up(v.y), snorm16(v.z), 0];
+        let bytes: Vec<u8> = instances
+            .iter()
+            .flat_map(|i| raised(i.translation))
+            .flat_map(|c| c.to_le_bytes())
+            .collect();
+        let view = self.view(&bytes, None, Some(8));
+        let translation = self.accessor(view, 0, count, I16, Vec3, true, None);
+        let bytes: Vec<u8> = instances
+            .iter()
+            .flat_map(|i| i.rotation.to_array().map(snorm16))
+            .flat_map(|c| c.to_le_bytes())
+            .collect();
+        let view = self.view(&bytes, None, None);
+        let rotation = self.accessor(view, 0, count, I16, Vec4, true, None);
+        let fits = instances.iter().all(|i| i.scale.max_element() <= 1.0);
+        let scale = if !with_scale {
+            None
+        } else if fits {
+            let bytes: Vec<u8> = instances
+                .iter()
+                .flat_map(|i| padded(i.scale))
+                .flat_map(|c| c.to_le_bytes())
+                .collect();
+            let view = self.view(&bytes, None, Some(8));
+            Some(self.accessor(view, 0, count, I16, Vec3, true, None))
+        } else {
+            let bytes = f32_bytes(
+                instances
+                    .iter()
+                    .flat_map(|i| i.scale.to_array())
+                    .collect::<Vec<_>>()
+                    .iter(),
+            );
+            let view = self.view(&bytes, None, None);
+            Some(self.accessor(view, 0, count, F32, Vec3, false, None))
+        };
+        let mut attributes = serde_json::json!({
+            "TRANSLATION": translation.value(),
+            "ROTATION": rotation.value(),
+        });
+        if let Some(scale) = scale {
+            attributes["SCALE"] = scale.value().into();
+        }
+        let mut others = serde_json::Map::new();
+        others.insert(
+            EXT_MESH_GPU_INSTANCING.into(),
+            serde_json::json!({ "attributes": attributes }),
+        );
+        self.root.push(json::Node {
+            mesh: Some(mesh),
+            name: Some(name),
+            extensions: Some(json::extensions::scene::Node { others }),
+            ..Default::default()
+        })
+    }
 }
 
 #[cfg(test)]

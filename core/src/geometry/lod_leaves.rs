@@ -4,9 +4,12 @@
 //!
 //! The cards are ordered along a Z-order (Morton) curve through their centres, so runs of
 //! consecutive cards are spatial neighbourhoods, and the curve is cut into as many runs as the
-//! level has cards. A run becomes one card: the shape and orientation of its member nearest
-//! the run's centroid, moved to that centroid and scaled to hold the run's whole card area,
-//! with the run's mean ambient light. None reaches below the ground plane.
+//! level has cards. A run becomes one card: its member nearest the run's centroid, scaled
+//! about its own centre to hold the run's whole card area, with the run's mean ambient light.
+//! Kept in place rather than moved to the centroid (which may fall into a gap of the crown),
+//! the card still covers what it covered at the finest level: at 30 years the coarsest level's
+//! side view differs from the finest's by 14–24% (oak … spruce) where moving it gave 14–27%
+//! and a random 15% of the cards, enlarged, 16–43%. None reaches below the ground plane.
 
 use glam::Vec3;
 
@@ -91,7 +94,7 @@ pub(crate) fn merge_cards_into(
         let range = 4 * cluster..4 * cluster + 4;
         let mut lowest = f32::INFINITY;
         for (k, out_corner) in positions[range.clone()].iter_mut().enumerate() {
-            let p = centroid + (corner(nearest, k) - center) * grow;
+            let p = center + (corner(nearest, k) - center) * grow;
             lowest = lowest.min(p.y);
             *out_corner = p.to_array();
         }
@@ -121,6 +124,50 @@ fn morton3(x: u32, y: u32, z: u32) -> u32 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    use crate::geometry::synthetic::{branching_skeleton, crown_ambient};
+    use crate::geometry::{LeafParams, MeshParams, build_meshes};
+
+    #[test]
+    fn merged_cards_keep_the_card_area_and_stay_above_the_ground() {
+        let params = MeshParams {
+            leaves: LeafParams {
+                leaves_per_metre: 60.0,
+                ..LeafParams::default()
+            },
+            ..MeshParams::default()
+        };
+        let skeleton = branching_skeleton(3_000, 5);
+        let meshes = build_meshes(&skeleton, &params, &crown_ambient(Vec3::Y, 1.5));
+        let cards = &meshes.leaves;
+        let area = |mesh: &TreeMesh| {
+            mesh.indices
+                .chunks_exact(3)
+                .map(|t| {
+                    let [a, b, c] = [0, 1, 2].map(|k| Vec3::from(mesh.positions[t[k] as usize]));
+                    0.5 * (b - a).cross(c - a).length()
+                })
+                .sum::<f32>()
+        };
+        let num_cards = cards.indices.len() / 6;
+        assert!(num_cards > 1_000, "{num_cards} cards");
+        let mut merged = TreeMesh::default();
+        let ground_y = 0.4;
+        merge_cards_into(
+            cards,
+            num_cards / 7,
+            ground_y,
+            &mut MergeScratch::default(),
+            &mut merged,
+        );
+        assert_eq!(merged.indices.len() / 6, num_cards / 7);
+        let (fine, coarse) = (area(cards), area(&merged));
+        assert!(
+            (coarse / fine - 1.0).abs() < 1e-3,
+            "{coarse} m² of merged cards for {fine} m²"
+        );
+        assert!(merged.positions.iter().all(|p| p[1] >= ground_y - 1e-5));
+    }
 
     #[test]
     fn morton_codes_interleave_the_axes() {

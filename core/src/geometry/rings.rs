@@ -85,9 +85,9 @@ impl Reflections {
 /// A lateral chain's first ring sits at the branching point (it is laid onto the parent surface
 /// when emitted); the following rings that still lie inside the parent tube are dropped. Rings
 /// of joints that stand off the straight line between their neighbours by less than
-/// [`MeshParams::ring_tolerance`] of the radius (or [`MeshParams::ring_tolerance_m`]) are then left out ([`simplify_chain`]), except
-/// where `anchors` (per internode of the arena) says a branch grows from the joint; `joints` is
-/// working memory.
+/// [`MeshParams::ring_tolerance`] of the radius (or [`MeshParams::ring_tolerance_m`]) are then
+/// left out ([`simplify_chain`]), except where `anchors` (per internode of the arena) says a
+/// branch grows from the joint; `joints` is working memory.
 ///
 /// The reference vectors of all but the first ring are left to [`carry_references`].
 #[allow(clippy::too_many_arguments)]
@@ -122,8 +122,9 @@ pub(super) fn push_chain_rings(
 
 /// Leaves out the rings of `rings[first..]` (one chain; ring `first + 1 + k` sits at the end
 /// of internode `joints[k]`) whose centre lies within `tolerance` × its radius, or within
-/// `tolerance_m` metres, of the segment between the rings kept before and after it, greedily from the base; keeps the first two
-/// rings, the tip and the rings at `anchors`' joints. The rings kept move down in place.
+/// `tolerance_m` metres, of the segment between the rings kept before and after it, greedily
+/// from the base; keeps the first two rings, the tip and the rings at `anchors`' joints. The
+/// rings kept move down in place.
 fn simplify_chain(
     rings: &mut Vec<Ring>,
     first: usize,
