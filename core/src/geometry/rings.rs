@@ -285,3 +285,72 @@ pub(super) fn carry_references(
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Rings of radius 1 cm at `centers`, the joints numbered 0, 1, … after the first ring.
+    fn rings_at(centers: &[Vec3]) -> (Vec<Ring>, Vec<u32>) {
+        let rings = centers
+            .iter()
+            .map(|&center| Ring {
+                center,
+                tangent: Vec3::Y,
+                reference: Vec3::X,
+                binormal: Vec3::Z,
+                radius: 0.01,
+                v: center.y,
+                u_offset: 0.0,
+                ambient: 1.0,
+            })
+            .collect();
+        (rings, (0..centers.len() as u32 - 1).collect())
+    }
+
+    fn kept_heights(rings: &[Ring]) -> Vec<f32> {
+        rings.iter().map(|r| (r.center.y * 10.0).round()).collect()
+    }
+
+    #[test]
+    fn a_straight_chain_keeps_its_base_the_ring_above_and_its_tip_and_a_bend_or_a_branch_stays() {
+        let straight: Vec<Vec3> = (0..10)
+            .map(|k| Vec3::new(0.0, 0.1 * k as f32, 0.0))
+            .collect();
+        let (mut rings, joints) = rings_at(&straight);
+        simplify_chain(&mut rings, 0, &joints, &[false; 9], (0.25, 0.0));
+        assert_eq!(kept_heights(&rings), [0.0, 1.0, 9.0]);
+
+        // A kink of 5 cm at the sixth ring (5 radii off the line) keeps that ring.
+        let mut bent = straight.clone();
+        for p in &mut bent[5..] {
+            p.x += 0.05;
+        }
+        bent[5].x = 0.05;
+        let (mut rings, joints) = rings_at(&bent);
+        simplify_chain(&mut rings, 0, &joints, &[false; 9], (0.25, 0.0));
+        assert!(kept_heights(&rings).contains(&5.0) || kept_heights(&rings).contains(&4.0));
+        assert!(rings.len() < bent.len(), "{} rings", rings.len());
+
+        // A branch growing from the end of internode 3 (ring 4) keeps that ring.
+        let (mut rings, joints) = rings_at(&straight);
+        let mut anchors = [false; 9];
+        anchors[3] = true;
+        simplify_chain(&mut rings, 0, &joints, &anchors, (0.25, 0.0));
+        assert_eq!(kept_heights(&rings), [0.0, 1.0, 4.0, 9.0]);
+    }
+
+    #[test]
+    fn a_tolerance_in_metres_lets_a_thin_twig_lose_rings_its_radius_alone_would_keep() {
+        // A twig of 1 cm radius wavering by 3 mm: over a quarter of its radius, under 4 mm.
+        let wavy: Vec<Vec3> = (0..10)
+            .map(|k| Vec3::new(if k % 2 == 0 { 0.0 } else { 0.003 }, 0.1 * k as f32, 0.0))
+            .collect();
+        let (mut by_radius, joints) = rings_at(&wavy);
+        simplify_chain(&mut by_radius, 0, &joints, &[false; 9], (0.25, 0.0));
+        let (mut by_metres, _) = rings_at(&wavy);
+        simplify_chain(&mut by_metres, 0, &joints, &[false; 9], (0.25, 0.004));
+        assert_eq!(by_radius.len(), wavy.len(), "every ring stays by radius");
+        assert!(by_metres.len() <= 3, "{} rings", by_metres.len());
+    }
+}
