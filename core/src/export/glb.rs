@@ -35,8 +35,8 @@ pub fn glb_bytes(meshes: &TreeMeshes) -> Result<Vec<u8>, ExportError> {
     build(meshes, Path::new("<memory>"))
 }
 
-/// Buffer views of one mesh's quantized vertex attributes and its 16-bit indices, which the
-/// primitives of every level drawing a prefix of it share.
+/// Buffer views of one mesh's quantized vertex attributes, which the primitives drawing parts
+/// of it share (every level draws a prefix of the fruit's).
 struct VertexViews {
     /// The quantized positions (for the accessors' bounds) and their view.
     positions: Vec<[i16; 4]>,
