@@ -38,8 +38,9 @@ if [ -f tools/gltf-validator/package.json ] && [ ! -d tools/gltf-validator/node_
 fi
 
 # A real glTF reader for the export tests: glTF Transform, pinned in tools/gltf-reader/package.json.
-if [ -f tools/gltf-reader/package.json ] && [ ! -d tools/gltf-reader/node_modules/@gltf-transform/core ]; then
-  echo "setup: installing @gltf-transform/core"
+if [ -f tools/gltf-reader/package.json ] && { [ ! -d tools/gltf-reader/node_modules/@gltf-transform/core ] ||
+  [ ! -d tools/gltf-reader/node_modules/@gltf-transform/extensions ]; }; then
+  echo "setup: installing @gltf-transform/core and /extensions"
   (cd tools/gltf-reader && npm install --no-audit --no-fund --silent >/dev/null)
 fi
 

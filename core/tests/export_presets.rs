@@ -46,8 +46,9 @@ fn every_preset_exports_a_valid_crack_free_glb_with_leaves_and_lods_on_target() 
             report.num_warnings
         );
         assert_eq!(
-            report.num_errors, 0,
-            "{name}: validator errors: {}",
+            (report.num_errors, report.num_warnings),
+            (0, 0),
+            "{name}: validator errors and warnings: {}",
             report.text
         );
         support::assert_reimport_matches(&path, &meshes);
@@ -60,4 +61,60 @@ fn every_preset_exports_a_valid_crack_free_glb_with_leaves_and_lods_on_target() 
             );
         }
     }
+}
+
+/// The largest `.glb` and the most triangles at LOD0 a 40-year tree may have (issue #25).
+const MAX_GLB_BYTES: usize = 15_000_000;
+const MAX_LOD0_TRIANGLES: u64 = 600_000;
+
+#[test]
+fn every_preset_at_40_years_exports_a_valid_glb_within_15_mb_and_600k_triangles() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let mut failures = Vec::new();
+    for species in Species::presets() {
+        let name = species.name.clone();
+        let mut tree = Tree::new(species, SEED);
+        tree.grow_years(40.0);
+        let meshes = build_tree_meshes(&tree);
+        let path = dir.path().join(format!("{name}.glb"));
+        write_glb(&meshes, &path).unwrap_or_else(|e| panic!("{name}: {e}"));
+        let bytes = std::fs::metadata(&path).expect("written").len() as usize;
+        let report = support::validate_glb(&path);
+        // Triangles as a reader draws them: bark and fruit, plus the leaf card mesh's
+        // triangles times its instances (glTF Transform expands EXT_mesh_gpu_instancing).
+        let read = support::read_glb_with_gltf_transform(&path);
+        let drawn = read["levels"][0]["drawn_triangles"]
+            .as_u64()
+            .expect("LOD0 triangles");
+        let coarsest = meshes.lods.len() - 1;
+        let ratio = meshes.num_triangles(coarsest) as f32 / meshes.num_triangles(0) as f32;
+        println!(
+            "{name}: {:.2} MB, LOD0 {drawn} triangles ({} own, {} in leaf instances), \
+             LOD{coarsest} {:.1}% of them; validator {} errors {} warnings",
+            bytes as f64 * 1e-6,
+            meshes.num_triangles(0) - meshes.lods[0].num_leaf_indices / 3,
+            meshes.lods[0].num_leaf_indices / 3,
+            100.0 * ratio,
+            report.num_errors,
+            report.num_warnings
+        );
+        assert_eq!(
+            drawn,
+            meshes.num_triangles(0) as u64,
+            "{name}: LOD0 read back"
+        );
+        if bytes > MAX_GLB_BYTES {
+            failures.push(format!("{name}: {bytes} bytes"));
+        }
+        if drawn > MAX_LOD0_TRIANGLES {
+            failures.push(format!("{name}: {drawn} triangles at LOD0"));
+        }
+        if ratio > 0.15 + 1e-3 {
+            failures.push(format!("{name}: the coarsest level has {ratio:.3} of them"));
+        }
+        if report.num_errors + report.num_warnings > 0 {
+            failures.push(format!("{name}: validator: {}", report.text));
+        }
+    }
+    assert!(failures.is_empty(), "{}", failures.join("\n"));
 }

@@ -6,6 +6,8 @@ use std::path::Path;
 use gltf_json as json;
 use json::validation::{Checked::Valid, USize64};
 
+use super::leaf_instances::{CardKind, EXT_MESH_GPU_INSTANCING, card_instances, common_scale};
+use super::quantize::{self, Quantizer, UvBox};
 use super::{ExportError, TEXTURE_SIZE, ambient_color};
 use crate::geometry::leaf_card::card_texture;
 use crate::geometry::textures::{bark_texture, png_bytes};
@@ -13,6 +15,10 @@ use crate::geometry::{TreeMesh, TreeMeshes};
 
 /// The glTF extension naming a node's coarser levels of detail.
 const MSFT_LOD: &str = "MSFT_lod";
+/// The glTF extension allowing quantized (integer) positions, normals and instance transforms.
+const KHR_MESH_QUANTIZATION: &str = "KHR_mesh_quantization";
+/// The glTF extension mapping quantized texture coordinates back to the texture's.
+const KHR_TEXTURE_TRANSFORM: &str = "KHR_texture_transform";
 
 pub(super) const GLB_MAGIC: u32 = 0x4654_6C67; // "glTF"
 pub(super) const CHUNK_JSON: u32 = 0x4E4F_534A;
@@ -29,26 +35,79 @@ pub fn glb_bytes(meshes: &TreeMeshes) -> Result<Vec<u8>, ExportError> {
     build(meshes, Path::new("<memory>"))
 }
 
-/// Accessors of one vertex buffer (views shared by every level that draws a prefix of it).
-#[derive(Clone, Copy)]
+/// Buffer views of one mesh's quantized vertex attributes, which the primitives drawing parts
+/// of it share (every level draws a prefix of the fruit's).
 struct VertexViews {
-    positions: json::Index<json::buffer::View>,
+    /// The quantized positions (for the accessors' bounds) and their view.
+    positions: Vec<[i16; 4]>,
+    position_view: json::Index<json::buffer::View>,
     normals: json::Index<json::buffer::View>,
     uvs: Option<json::Index<json::buffer::View>>,
     colors: json::Index<json::buffer::View>,
-    indices: json::Index<json::buffer::View>,
 }
 
-struct Builder<'a> {
-    root: json::Root,
+/// A run of triangles whose vertices span fewer than 2¹⁶ − 1 indices: one primitive with
+/// 16-bit indices (65,535 is the primitive restart value, never used as an index).
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct Chunk {
+    /// Range of the run's indices.
+    first_index: usize,
+    end_index: usize,
+    /// First and last vertex the run uses.
+    first_vertex: u32,
+    last_vertex: u32,
+}
+
+/// The first `num_indices` of `indices` cut into runs of triangles of 16-bit reach.
+fn chunks(indices: &[u32], num_indices: usize) -> Vec<Chunk> {
+    let mut out = Vec::new();
+    let triangles = indices[..num_indices.min(indices.len())].chunks_exact(3);
+    let mut current: Option<Chunk> = None;
+    for (t, triangle) in triangles.enumerate() {
+        let lo = triangle.iter().copied().min().unwrap_or(0);
+        let hi = triangle.iter().copied().max().unwrap_or(0);
+        current = Some(match current {
+            Some(chunk) => {
+                let (first, last) = (chunk.first_vertex.min(lo), chunk.last_vertex.max(hi));
+                if last - first >= u32::from(u16::MAX) {
+                    out.push(chunk);
+                    Chunk {
+                        first_index: 3 * t,
+                        end_index: 3 * t + 3,
+                        first_vertex: lo,
+                        last_vertex: hi,
+                    }
+                } else {
+                    Chunk {
+                        end_index: 3 * t + 3,
+                        first_vertex: first,
+                        last_vertex: last,
+                        ..chunk
+                    }
+                }
+            }
+            None => Chunk {
+                first_index: 0,
+                end_index: 3,
+                first_vertex: lo,
+                last_vertex: hi,
+            },
+        });
+    }
+    out.extend(current);
+    out
+}
+
+pub(super) struct Builder<'a> {
+    pub(super) root: json::Root,
     bin: Vec<u8>,
     path: &'a Path,
 }
 
 impl<'a> Builder<'a> {
     /// A buffer view of `bytes`; vertex attribute views carry their element size as stride, since
-    /// every level of detail drawing a prefix shares them.
-    fn view(
+    /// the primitives drawing parts of them share them.
+    pub(super) fn view(
         &mut self,
         bytes: &[u8],
         target: Option<json::buffer::Target>,
@@ -72,120 +131,188 @@ impl<'a> Builder<'a> {
     }
 
     #[allow(clippy::too_many_arguments)]
-    fn accessor(
+    pub(super) fn accessor(
         &mut self,
         view: json::Index<json::buffer::View>,
+        byte_offset: usize,
         count: usize,
         component: json::accessor::ComponentType,
         type_: json::accessor::Type,
         normalized: bool,
-        bounds: Option<([f32; 3], [f32; 3])>,
+        bounds: Option<(Vec<f32>, Vec<f32>)>,
     ) -> json::Index<json::Accessor> {
+        let value = |v: Vec<f32>| {
+            json::Value::from(
+                v.into_iter()
+                    .map(|x| json::Value::from(x as f64))
+                    .collect::<Vec<_>>(),
+            )
+        };
+        let (min, max) = match bounds {
+            Some((lo, hi)) => (Some(value(lo)), Some(value(hi))),
+            None => (None, None),
+        };
         self.root.push(json::Accessor {
             buffer_view: Some(view),
-            byte_offset: None,
+            byte_offset: (byte_offset > 0).then(|| USize64::from(byte_offset)),
             count: USize64::from(count),
             component_type: Valid(json::accessor::GenericComponentType(component)),
             extensions: None,
             extras: Default::default(),
             type_: Valid(type_),
-            min: bounds.map(|(lo, _)| json::Value::from(lo.to_vec())),
-            max: bounds.map(|(_, hi)| json::Value::from(hi.to_vec())),
+            min,
+            max,
             name: None,
             normalized,
             sparse: None,
         })
     }
 
-    /// The buffer views of `mesh`'s attributes; texture coordinates only `with_uvs` (a part
-    /// drawn without a texture gets none, which readers would carry unused).
-    fn vertex_views(&mut self, mesh: &TreeMesh, with_uvs: bool) -> VertexViews {
-        use json::buffer::Target::{ArrayBuffer, ElementArrayBuffer};
-        let positions = self.view(
-            &f32_bytes(mesh.positions.iter().flatten()),
-            Some(ArrayBuffer),
-            Some(12),
-        );
-        let normals = self.view(
-            &f32_bytes(mesh.normals.iter().flatten()),
-            Some(ArrayBuffer),
-            Some(12),
-        );
-        let uvs = with_uvs.then(|| {
-            self.view(
-                &f32_bytes(mesh.uvs.iter().flatten()),
-                Some(ArrayBuffer),
-                Some(8),
-            )
+    /// The buffer views of the first `num_vertices` vertices of `mesh`, quantized by
+    /// `quantizer`; texture coordinates only with a `uvs` box to quantize them in (a part drawn
+    /// without a texture gets none, which readers would carry unused).
+    fn vertex_views(
+        &mut self,
+        mesh: &TreeMesh,
+        num_vertices: usize,
+        uvs: Option<&UvBox>,
+        quantizer: &Quantizer,
+    ) -> VertexViews {
+        use json::buffer::Target::ArrayBuffer;
+        let positions: Vec<[i16; 4]> = mesh.positions[..num_vertices]
+            .iter()
+            .map(|&p| quantizer.position(p))
+            .collect();
+        let bytes: Vec<u8> = positions
+            .iter()
+            .flatten()
+            .flat_map(|v| v.to_le_bytes())
+            .collect();
+        let position_view = self.view(&bytes, Some(ArrayBuffer), Some(8));
+        let bytes: Vec<u8> = mesh.normals[..num_vertices]
+            .iter()
+            .flat_map(|&n| quantize::normal(n).map(|c| c as u8))
+            .collect();
+        let normals = self.view(&bytes, Some(ArrayBuffer), Some(4));
+        let uvs = uvs.map(|uv_box| {
+            let bytes: Vec<u8> = mesh.uvs[..num_vertices]
+                .iter()
+                .flat_map(|&uv| uv_box.quantize(uv))
+                .flat_map(|c| c.to_le_bytes())
+                .collect();
+            self.view(&bytes, Some(ArrayBuffer), Some(4))
         });
-        let colors: Vec<u8> = mesh
-            .ambient
+        let bytes: Vec<u8> = mesh.ambient[..num_vertices]
             .iter()
             .flat_map(|&a| {
-                let c = (ambient_color(a) * 255.0 + 0.5) as u8;
+                let c = quantize::unorm8(ambient_color(a));
                 [c, c, c, 255]
             })
             .collect();
-        let colors = self.view(&colors, Some(ArrayBuffer), Some(4));
-        let indices: Vec<u8> = mesh.indices.iter().flat_map(|i| i.to_le_bytes()).collect();
-        let indices = self.view(&indices, Some(ElementArrayBuffer), None);
+        let colors = self.view(&bytes, Some(ArrayBuffer), Some(4));
         VertexViews {
             positions,
+            position_view,
             normals,
             uvs,
             colors,
-            indices,
         }
     }
 
-    /// A triangle primitive drawing the first `num_indices` indices of `mesh`.
-    fn primitive(
+    /// Triangle primitives drawing the first `num_indices` indices of `mesh` (whose vertices
+    /// `views` holds), one per run of 16-bit reach.
+    fn primitives(
         &mut self,
         mesh: &TreeMesh,
         views: &VertexViews,
         num_indices: usize,
         material: json::Index<json::Material>,
-    ) -> json::mesh::Primitive {
-        use json::accessor::ComponentType::{F32, U8, U32};
+    ) -> Vec<json::mesh::Primitive> {
+        use json::accessor::ComponentType::{I8, I16, U8, U16, U32};
         use json::accessor::Type::{Scalar, Vec2, Vec3, Vec4};
-        let num_vertices = mesh.num_vertices_of_prefix(num_indices);
-        let bounds = mesh.positions[..num_vertices].iter().fold(
-            ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]),
-            |(lo, hi), p| {
-                (
-                    [lo[0].min(p[0]), lo[1].min(p[1]), lo[2].min(p[2])],
-                    [hi[0].max(p[0]), hi[1].max(p[1]), hi[2].max(p[2])],
-                )
-            },
-        );
-        let mut attributes = std::collections::BTreeMap::new();
-        let position = self.accessor(
-            views.positions,
-            num_vertices,
-            F32,
-            Vec3,
-            false,
-            Some(bounds),
-        );
-        attributes.insert(Valid(json::mesh::Semantic::Positions), position);
-        let normal = self.accessor(views.normals, num_vertices, F32, Vec3, false, None);
-        attributes.insert(Valid(json::mesh::Semantic::Normals), normal);
-        if let Some(uvs) = views.uvs {
-            let uv = self.accessor(uvs, num_vertices, F32, Vec2, false, None);
-            attributes.insert(Valid(json::mesh::Semantic::TexCoords(0)), uv);
+        let runs = chunks(&mesh.indices, num_indices);
+        // Each run's indices relative to its first vertex, as 16-bit integers; a run that
+        // reaches further (a single triangle spanning 2¹⁶ vertices, which no tree mesh has)
+        // as 32-bit ones, aligned to 4 bytes.
+        let mut index_bytes = Vec::with_capacity(2 * num_indices);
+        let mut index_starts = Vec::with_capacity(runs.len());
+        for run in &runs {
+            let wide = run.last_vertex - run.first_vertex >= u32::from(u16::MAX);
+            if wide {
+                while !index_bytes.len().is_multiple_of(4) {
+                    index_bytes.push(0);
+                }
+            }
+            index_starts.push((index_bytes.len(), if wide { U32 } else { U16 }));
+            for &i in &mesh.indices[run.first_index..run.end_index] {
+                let relative = i - run.first_vertex;
+                if wide {
+                    index_bytes.extend_from_slice(&relative.to_le_bytes());
+                } else {
+                    index_bytes.extend_from_slice(&(relative as u16).to_le_bytes());
+                }
+            }
         }
-        let color = self.accessor(views.colors, num_vertices, U8, Vec4, true, None);
-        attributes.insert(Valid(json::mesh::Semantic::Colors(0)), color);
-        let indices = self.accessor(views.indices, num_indices, U32, Scalar, false, None);
-        json::mesh::Primitive {
-            attributes,
-            extensions: None,
-            extras: Default::default(),
-            indices: Some(indices),
-            material: Some(material),
-            mode: Valid(json::mesh::Mode::Triangles),
-            targets: None,
+        let index_view = self.view(
+            &index_bytes,
+            Some(json::buffer::Target::ElementArrayBuffer),
+            None,
+        );
+        let mut out = Vec::with_capacity(runs.len());
+        for (run, (index_offset, index_component)) in runs.into_iter().zip(index_starts) {
+            let (first, count) = (
+                run.first_vertex as usize,
+                (run.last_vertex - run.first_vertex) as usize + 1,
+            );
+            let (lo, hi) = views.positions[first..first + count].iter().fold(
+                ([i16::MAX; 3], [i16::MIN; 3]),
+                |(lo, hi), q| {
+                    (
+                        [lo[0].min(q[0]), lo[1].min(q[1]), lo[2].min(q[2])],
+                        [hi[0].max(q[0]), hi[1].max(q[1]), hi[2].max(q[2])],
+                    )
+                },
+            );
+            let bounds = (lo.map(f32::from).to_vec(), hi.map(f32::from).to_vec());
+            let mut attributes = std::collections::BTreeMap::new();
+            let position = self.accessor(
+                views.position_view,
+                8 * first,
+                count,
+                I16,
+                Vec3,
+                true,
+                Some(bounds),
+            );
+            attributes.insert(Valid(json::mesh::Semantic::Positions), position);
+            let normal = self.accessor(views.normals, 4 * first, count, I8, Vec3, true, None);
+            attributes.insert(Valid(json::mesh::Semantic::Normals), normal);
+            if let Some(uvs) = views.uvs {
+                let uv = self.accessor(uvs, 4 * first, count, U16, Vec2, true, None);
+                attributes.insert(Valid(json::mesh::Semantic::TexCoords(0)), uv);
+            }
+            let color = self.accessor(views.colors, 4 * first, count, U8, Vec4, true, None);
+            attributes.insert(Valid(json::mesh::Semantic::Colors(0)), color);
+            let indices = self.accessor(
+                index_view,
+                index_offset,
+                run.end_index - run.first_index,
+                index_component,
+                Scalar,
+                false,
+                None,
+            );
+            out.push(json::mesh::Primitive {
+                attributes,
+                extensions: None,
+                extras: Default::default(),
+                indices: Some(indices),
+                material: Some(material),
+                mode: Valid(json::mesh::Mode::Triangles),
+                targets: None,
+            });
         }
+        out
     }
 
     /// A texture from a PNG stored in the BIN chunk.
@@ -222,14 +349,28 @@ impl<'a> Builder<'a> {
         })
     }
 
+    /// A material; a texture read through `uv_box` (quantized texture coordinates) says so by
+    /// `KHR_texture_transform`.
+    #[allow(clippy::field_reassign_with_default)]
     fn material(
         &mut self,
         name: &str,
         texture: Option<json::Index<json::Texture>>,
+        uv_box: Option<&UvBox>,
         color: [f32; 4],
         roughness: f32,
         leaf: bool,
     ) -> json::Index<json::Material> {
+        let extensions = uv_box.map(|uv_box| {
+            let mut others = serde_json::Map::new();
+            others.insert(
+                KHR_TEXTURE_TRANSFORM.into(),
+                serde_json::json!({ "offset": uv_box.offset, "scale": uv_box.scale }),
+            );
+            let mut info = json::extensions::texture::Info::default();
+            info.others = others;
+            info
+        });
         self.root.push(json::Material {
             alpha_cutoff: leaf.then_some(json::material::AlphaCutoff(0.5)),
             alpha_mode: Valid(if leaf {
@@ -244,7 +385,7 @@ impl<'a> Builder<'a> {
                 base_color_texture: texture.map(|index| json::texture::Info {
                     index,
                     tex_coord: 0,
-                    extensions: None,
+                    extensions,
                     extras: Default::default(),
                 }),
                 metallic_factor: json::material::StrengthFactor(0.0),
@@ -272,7 +413,7 @@ impl<'a> Builder<'a> {
     }
 }
 
-fn f32_bytes<'a>(values: impl Iterator<Item = &'a f32>) -> Vec<u8> {
+pub(super) fn f32_bytes<'a>(values: impl Iterator<Item = &'a f32>) -> Vec<u8> {
     values.flat_map(|v| v.to_le_bytes()).collect()
 }
 
@@ -288,82 +429,134 @@ fn build(meshes: &TreeMeshes, path: &Path) -> Result<Vec<u8>, ExportError> {
         path,
     };
     builder.root.asset.generator = Some(format!("Sylva {}", env!("CARGO_PKG_VERSION")));
+    // One box for every level, so that they share the fruit's quantized vertices.
+    let quantizer = Quantizer::of(
+        (0..meshes.lods.len())
+            .filter_map(|level| meshes.bounds(level))
+            .reduce(|(a0, a1), (b0, b1)| (a0.min(b0), a1.max(b1)))
+            .unwrap_or((glam::Vec3::ZERO, glam::Vec3::ONE)),
+    );
     let opaque = |c: [f32; 3]| [c[0], c[1], c[2], 1.0];
     let bark_png = builder.png(
         "bark texture",
         &bark_texture(meshes.colors.bark_kind, meshes.colors.bark, TEXTURE_SIZE),
     )?;
     let bark_texture = builder.texture("bark", &bark_png, json::texture::WrappingMode::Repeat);
-    let bark = builder.material("bark", Some(bark_texture), [1.0; 4], 0.95, false);
+    let uv_box = UvBox::of(meshes.lods.iter().flat_map(|lod| &lod.branches.uvs));
+    let bark = builder.material(
+        "bark",
+        Some(bark_texture),
+        Some(&uv_box),
+        [1.0; 4],
+        0.95,
+        false,
+    );
     let leaf = if meshes.leaves.is_empty() {
         None
     } else {
         let leaf_png = builder.png("leaf texture", &card_texture(meshes, TEXTURE_SIZE))?;
         let texture = builder.texture("leaf", &leaf_png, json::texture::WrappingMode::ClampToEdge);
-        let views = builder.vertex_views(&meshes.leaves, true);
-        Some((
-            builder.material("leaf", Some(texture), [1.0; 4], 0.6, true),
-            views,
-        ))
+        Some(builder.material("leaf", Some(texture), None, [1.0; 4], 0.6, true))
     };
     let fruit = if meshes.fruit.is_empty() {
         None
     } else {
-        let views = builder.vertex_views(&meshes.fruit, false);
+        let num_vertices = meshes.fruit.num_vertices();
+        let views = builder.vertex_views(&meshes.fruit, num_vertices, None, &quantizer);
         Some((
-            builder.material("fruit", None, opaque(meshes.colors.fruit), 0.45, false),
+            builder.material(
+                "fruit",
+                None,
+                None,
+                opaque(meshes.colors.fruit),
+                0.45,
+                false,
+            ),
             views,
         ))
     };
+    let card_size = (meshes.leaf_card.width_m, meshes.leaf_card.length_m);
+    let mut card_meshes: Vec<(CardKind, Option<[u32; 3]>, json::Index<json::Mesh>)> = Vec::new();
     let mut level_nodes = Vec::new();
     for (level, lod) in meshes.lods.iter().enumerate() {
         let mut primitives = Vec::new();
         if !lod.branches.is_empty() {
-            let views = builder.vertex_views(&lod.branches, true);
-            primitives.push(builder.primitive(
-                &lod.branches,
-                &views,
-                lod.branches.indices.len(),
-                bark,
-            ));
-        }
-        if let Some((material, views)) = leaf.as_ref().filter(|_| lod.num_leaf_indices > 0) {
-            let cards = lod.leaves_in(&meshes.leaves);
-            // The finest level's cards are shared views; a coarse level's merged cards get
-            // their own.
-            let views = if lod.level == 0 {
-                *views
-            } else {
-                builder.vertex_views(cards, true)
-            };
-            primitives.push(builder.primitive(cards, &views, lod.num_leaf_indices, *material));
+            let branches = &lod.branches;
+            let views =
+                builder.vertex_views(branches, branches.num_vertices(), Some(&uv_box), &quantizer);
+            primitives.extend(builder.primitives(branches, &views, branches.indices.len(), bark));
         }
         if let Some((material, views)) = fruit.as_ref().filter(|_| lod.num_fruit_indices > 0) {
-            primitives.push(builder.primitive(
+            primitives.extend(builder.primitives(
                 &meshes.fruit,
                 views,
                 lod.num_fruit_indices,
                 *material,
             ));
         }
-        if primitives.is_empty() {
+        let mut children = Vec::new();
+        if let Some(material) = leaf.filter(|_| lod.num_leaf_indices > 0) {
+            let cards = lod.leaves_in(&meshes.leaves);
+            let groups = card_instances(cards, lod.num_leaf_indices, card_size, &quantizer);
+            for (kind, instances) in groups {
+                // Cards all of one size (the finest level's) carry no scale of their own.
+                let baked = common_scale(&instances);
+                let key = baked.map(|s| s.to_array().map(f32::to_bits));
+                let mesh = match card_meshes.iter().find(|(k, b, _)| *k == kind && *b == key) {
+                    Some(&(_, _, mesh)) => mesh,
+                    None => {
+                        let mesh = builder.card_mesh(kind, card_size, baked, material);
+                        card_meshes.push((kind, key, mesh));
+                        mesh
+                    }
+                };
+                let name = format!(
+                    "tree_LOD{level}_leaves_ambient{}_{}",
+                    kind.ambient_level,
+                    if kind.normal_up { "up" } else { "down" }
+                );
+                children.push(builder.instance_node(name, mesh, &instances, baked.is_none()));
+            }
+        }
+        if primitives.is_empty() && children.is_empty() {
             continue;
         }
-        let name = format!("LOD{level}");
-        let mesh = builder.root.push(json::Mesh {
-            extensions: None,
-            extras: Default::default(),
-            name: Some(format!("tree_{name}")),
-            primitives,
-            weights: None,
+        let name = format!("tree_LOD{level}");
+        let mesh = (!primitives.is_empty()).then(|| {
+            builder.root.push(json::Mesh {
+                extensions: None,
+                extras: Default::default(),
+                name: Some(name.clone()),
+                primitives,
+                weights: None,
+            })
         });
+        let c = quantizer.center;
         level_nodes.push(builder.root.push(json::Node {
-            mesh: Some(mesh),
-            name: Some(format!("tree_{name}")),
+            mesh,
+            name: Some(name),
+            translation: Some([c.x, c.y, c.z]),
+            scale: Some([quantizer.half_extent; 3]),
+            children: (!children.is_empty()).then_some(children),
             ..Default::default()
         }));
     }
-    // One scene with one tree: the finest level is a plain mesh node, which readers without
+    // Quantized bark texture coordinates are read through the bark texture's transform.
+    for extension in [KHR_MESH_QUANTIZATION, KHR_TEXTURE_TRANSFORM] {
+        builder.root.extensions_used.push(extension.into());
+        builder.root.extensions_required.push(extension.into());
+    }
+    if !card_meshes.is_empty() {
+        builder
+            .root
+            .extensions_used
+            .push(EXT_MESH_GPU_INSTANCING.into());
+        builder
+            .root
+            .extensions_required
+            .push(EXT_MESH_GPU_INSTANCING.into());
+    }
+    // One scene with one tree: the finest level is a plain node, which readers without
     // MSFT_lod draw; its MSFT_lod extension lists the coarser levels' nodes, finest first.
     // The extension is used, not required.
     if let Some((&finest, coarser)) = level_nodes.split_first() {
@@ -424,4 +617,40 @@ pub(super) fn container(
     out.extend_from_slice(&CHUNK_BIN.to_le_bytes());
     out.extend_from_slice(&bin);
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn index_runs_stay_within_16_bits_and_cover_every_triangle() {
+        // Three "chains" of 40,000 vertices each, one quad strip per chain.
+        let mut indices = Vec::new();
+        for chain in 0..3u32 {
+            let base = chain * 40_000;
+            for k in 0..19_999 {
+                let (a, b) = (base + 2 * k, base + 2 * k + 2);
+                indices.extend_from_slice(&[a, a + 1, b + 1, a, b + 1, b]);
+            }
+        }
+        let runs = chunks(&indices, indices.len());
+        assert!(runs.len() >= 2, "{runs:?}");
+        assert_eq!(runs[0].first_index, 0);
+        assert_eq!(runs.last().map(|r| r.end_index), Some(indices.len()));
+        for pair in runs.windows(2) {
+            assert_eq!(pair[0].end_index, pair[1].first_index);
+        }
+        for run in &runs {
+            assert!(
+                run.last_vertex - run.first_vertex < u32::from(u16::MAX),
+                "{run:?}"
+            );
+            let used = &indices[run.first_index..run.end_index];
+            assert!(
+                used.iter()
+                    .all(|&i| (run.first_vertex..=run.last_vertex).contains(&i))
+            );
+        }
+    }
 }

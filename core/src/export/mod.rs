@@ -5,15 +5,26 @@
 //! textures ([`crate::geometry::textures`]). Units are metres and Y is up, as glTF specifies and
 //! as Sylva's world space already is.
 //!
-//! glTF: one scene holding one tree, the node of the finest level (`tree_LOD0`, a plain mesh
-//! node that every reader draws); its `MSFT_lod` extension (used, not required) lists the nodes
-//! of the coarser levels (`tree_LOD1`, `tree_LOD2`), which are in no scene, so readers without
-//! the extension (Blender 3.4, three.js) show the finest level once; PBR metallic-roughness materials with embedded PNG textures; ambient light
-//! as `COLOR_0`. OBJ: the finest level only, textures written next to it.
+//! glTF: one scene holding one tree, the node of the finest level (`tree_LOD0`, a plain node
+//! that every reader draws); its `MSFT_lod` extension (used, not required) lists the nodes of
+//! the coarser levels (`tree_LOD1`, `tree_LOD2`), which are in no scene, so readers without the
+//! extension (Blender 3.4, three.js) show the finest level once. Each level's node draws the
+//! bark and fruit with quantized attributes (`KHR_mesh_quantization`, required: positions as
+//! normalized shorts in a box the node's translation and uniform scale map back to metres,
+//! normals as bytes; bark texture coordinates as normalized shorts that the bark texture's
+//! `KHR_texture_transform`, required, maps back), in primitives of 16-bit indices; its
+//! children draw the leaf cards as instances of one card mesh per ambient level
+//! (`EXT_mesh_gpu_instancing`, required: translation, rotation and scale per card as
+//! normalized shorts). PBR metallic-roughness materials with embedded PNG textures; ambient
+//! light as `COLOR_0`. Readers that lack these extensions refuse the file rather than show a
+//! wrong tree; for them the OBJ is the fallback. OBJ: the finest level only, every leaf card
+//! expanded to its quad, textures written next to it.
 
 mod garden;
 mod glb;
+mod leaf_instances;
 mod obj;
+mod quantize;
 
 use std::path::{Path, PathBuf};
 

@@ -103,6 +103,10 @@ pub(crate) struct RingFrames {
     /// The internodes of every chain in chain order (`BranchTopology::chain_nodes`): the rings
     /// walk chains, which jump around the arena, so they read this gathered copy.
     chain_geometry: Vec<NodeGeom>,
+    /// Per internode: whether a chain grows from its end (its ring is never left out).
+    anchors: Vec<bool>,
+    /// Working memory of [`push_chain_rings`].
+    joints: Vec<u32>,
 }
 
 /// Mid-radius of the polygonal contour of a parent with `sides` sides, relative to its
@@ -155,6 +159,14 @@ impl RingFrames {
         let chain_geometry = &mut self.chain_geometry;
         chain_geometry.clear();
         chain_geometry.extend(topology.chain_nodes.iter().map(|&n| nodes[n as usize]));
+        let anchors = &mut self.anchors;
+        anchors.clear();
+        anchors.resize(nodes.len(), false);
+        for chain in &topology.chains {
+            if let Some(anchor) = anchors.get_mut(chain.parent_node as usize) {
+                *anchor = true;
+            }
+        }
         rings.clear();
         rings.reserve(nodes.len() + topology.chains.len());
         chains.clear();
@@ -178,9 +190,11 @@ impl RingFrames {
                 geometry,
                 tube.as_ref(),
                 chain_nodes,
+                &self.anchors,
                 params,
                 circumference / tiles_around,
                 ambient,
+                &mut self.joints,
             );
             chains.push(ChainRings {
                 first_ring,

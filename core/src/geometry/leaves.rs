@@ -291,46 +291,6 @@ fn push_blades(mesh: &mut TreeMesh, petiole: &Petiole, block: &[Attachment], gro
     push_quad_indices(mesh, base, block.len());
 }
 
-/// The first `num_cards` cards of `cards` (the leaf buffer, in random order), each scaled by
-/// 1/√`fraction` about the midpoint of its base edge, into `out` (cleared first): a coarse
-/// level of detail's cards, standing for `1/fraction` times as many finer ones with the same
-/// total area, none below y = `ground_y`.
-pub(crate) fn merge_cards_into(
-    cards: &TreeMesh,
-    num_cards: usize,
-    fraction: f32,
-    ground_y: f32,
-    out: &mut TreeMesh,
-) {
-    out.clear();
-    let num_cards = num_cards.min(cards.indices.len() / 6);
-    let scale = 1.0 / fraction.clamp(1e-3, 1.0).sqrt();
-    out.reserve(4 * num_cards, 6 * num_cards);
-    let (positions, normals, uvs, ambient) = out.grow_vertices(4 * num_cards);
-    let n = 4 * num_cards;
-    // The leaf buffer holds card k's four vertices at 4k.
-    normals.copy_from_slice(&cards.normals[..n]);
-    uvs.copy_from_slice(&cards.uvs[..n]);
-    ambient.copy_from_slice(&cards.ambient[..n]);
-    for (card, out_card) in cards.positions[..n]
-        .chunks_exact(4)
-        .zip(positions.chunks_exact_mut(4))
-    {
-        let base = (Vec3::from(card[0]) + Vec3::from(card[1])) * 0.5;
-        let mut lowest = f32::INFINITY;
-        for (corner, out_corner) in card.iter().zip(out_card.iter_mut()) {
-            let p = base + (Vec3::from(*corner) - base) * scale;
-            lowest = lowest.min(p.y);
-            *out_corner = p.to_array();
-        }
-        let lift = (ground_y - lowest).max(0.0);
-        for corner in out_card.iter_mut() {
-            corner[1] += lift;
-        }
-    }
-    push_quad_indices(out, 0, num_cards);
-}
-
 /// Appends the indices of `num_quads` quads whose 4 vertices each (base-left, base-right,
 /// tip-left, tip-right) start at vertex `base`: counter-clockwise seen from the normal's side
 /// (H × L = U).

@@ -6,6 +6,7 @@ use glam::Vec3;
 
 use super::branches::RingFrames;
 use super::leaves::{self, LeafScratch};
+use super::lod_leaves::{self, MergeScratch};
 use super::topology::{BranchTopology, Links};
 use super::{
     AmbientFn, FruitParams, LOD_TRIANGLE_FRACTIONS, Lod, MaterialColors, MeshParams, NodeGeom,
@@ -43,6 +44,7 @@ pub struct Mesher {
     topology: BranchTopology,
     frames: RingFrames,
     leaf_scratch: LeafScratch,
+    merge_scratch: MergeScratch,
     kept: Vec<bool>,
     /// Centres of the fruit, in arena and bud order.
     fruit_centers: Vec<Vec3>,
@@ -97,11 +99,11 @@ impl Mesher {
             if level == 0 {
                 lod.merged_leaves.clear();
             } else {
-                leaves::merge_cards_into(
+                lod_leaves::merge_cards_into(
                     &meshes.leaves,
                     num_cards / 6,
-                    lod.target_fraction,
                     ground_y,
+                    &mut self.merge_scratch,
                     &mut lod.merged_leaves,
                 );
             }

@@ -7,6 +7,10 @@
 //!   C.3, [`topology`]) and the first ring of every lateral branch is laid onto its parent's
 //!   surface, so dominant laterals leave no cracks. Sides per branch C = 3·dⁿ/d_e (eq. C.2).
 //!   Bark UVs are tiled along the path with a small rotation per segment; normals are smooth.
+//!   Where a branch runs nearly straight, its joints get no ring of their own: a joint within
+//!   a quarter of the radius (or 4 mm) of the line between the rings around it is left out,
+//!   unless a branch grows from it ([`MeshParams::ring_tolerance`]); a 40-year willow's bark
+//!   goes from 579k to 392k triangles.
 //! - **Leaves** ([`leaves`]) are alpha-textured cards on branches thinner than a threshold, at a
 //!   density per metre of twig of their own (appendix C.1.1), oriented by the petiole model of
 //!   appendix C.1.2; sunlit leaves turn their blade to the light. A card holds a spray of
@@ -17,9 +21,10 @@
 //! - **Ambient**: every vertex carries the ambient light of the growth shadow grid, sampled
 //!   through a callback so this module does not depend on growth.
 //! - **Levels of detail** ([`Lod`]): about 100%, 40% and 15% of the triangles, by fewer sides,
-//!   dropping the thinnest branches, and merging leaf cards: a coarse level keeps a fraction f
-//!   of the randomly ordered cards, each scaled by 1/√f about its base, so the leaf area and
-//!   the crown's silhouette stay while the cards thin out.
+//!   dropping the thinnest branches, and merging leaf cards: a coarse level with a fraction f
+//!   of the cards merges runs of 1/f neighbouring cards (along a Morton curve) into one card
+//!   each, holding their area ([`lod_leaves`]), so the leaf area stays and the silhouette
+//!   mostly does ([`silhouette`] measures how far it departs).
 //!
 //! Building: [`build_meshes`] makes every level (export, LOD switching); [`build_level`] makes
 //! only the level a renderer draws, plus the whole leaf and fruit buffers; a [`Mesher`] kept
@@ -34,11 +39,13 @@ pub mod crown;
 mod lanes;
 pub mod leaf_card;
 pub mod leaves;
+mod lod_leaves;
 mod looks;
 mod mesher;
 mod parent_tube;
 mod petiole;
 mod rings;
+pub mod silhouette;
 pub mod synthetic;
 pub mod textures;
 pub mod topology;
@@ -64,6 +71,15 @@ pub type AmbientFn<'a> = &'a dyn Fn(Vec3) -> f32;
 /// Fractions of the full triangle count aimed at by the three levels of detail.
 pub const LOD_TRIANGLE_FRACTIONS: [f32; 3] = [1.0, 0.4, 0.15];
 
+/// Default of [`MeshParams::ring_tolerance`]: a joint off the straight line by less than a
+/// quarter of the branch's radius gets no ring of its own (the bark's outline moves by at most
+/// that, under a pixel until the branch is a few pixels wide).
+pub const RING_TOLERANCE: f32 = 0.25;
+
+/// Default of [`MeshParams::ring_tolerance_m`]: 4 mm, under one pixel of a 10 m tree seen whole
+/// on a screen 2,160 pixels high.
+pub const RING_TOLERANCE_M: f32 = 0.004;
+
 /// Parameters of the tree mesh. Lengths in metres.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 pub struct MeshParams {
@@ -74,6 +90,17 @@ pub struct MeshParams {
     /// twig 3 sides instead of 7 and a trunk its 16, which takes a 40-year willow's bark from
     /// 1.0M to 0.54M triangles.
     pub side_exponent: f32,
+    /// Largest distance, relative to the branch's radius there, by which a joint's centre may
+    /// stand off the straight line between the rings kept around it for its ring to be left
+    /// out: nearly straight runs of a branch get one segment instead of one per internode. A
+    /// ring where a visible branch grows out, a chain's first two rings and its tip are always
+    /// kept. 0 keeps every ring (files written before this parameter).
+    #[serde(default)]
+    pub ring_tolerance: f32,
+    /// The same distance in metres, for the thinnest twigs, whose radius is a few millimetres
+    /// (the larger of the two applies). 0 in files written before this parameter.
+    #[serde(default)]
+    pub ring_tolerance_m: f32,
     /// Side length of one square bark texture tile on a thick branch.
     pub bark_tile_size: f32,
     /// Largest rotation of the bark texture from one segment to the next, in turns.
@@ -101,6 +128,8 @@ impl Default for MeshParams {
         MeshParams {
             max_sides: 16,
             side_exponent: 1.4,
+            ring_tolerance: RING_TOLERANCE,
+            ring_tolerance_m: RING_TOLERANCE_M,
             bark_tile_size: 0.25,
             bark_twist: 0.02,
             tip_taper: 0.5,

@@ -83,10 +83,95 @@ impl Reflections {
 
 /// Appends the rings of one chain: a ring at the start of every internode and one at the tip.
 /// A lateral chain's first ring sits at the branching point (it is laid onto the parent surface
-/// when emitted); the following rings that still lie inside the parent tube are dropped.
+/// when emitted); the following rings that still lie inside the parent tube are dropped. Rings
+/// of joints that stand off the straight line between their neighbours by less than
+/// [`MeshParams::ring_tolerance`] of the radius (or [`MeshParams::ring_tolerance_m`]) are then
+/// left out ([`simplify_chain`]), except where `anchors` (per internode of the arena) says a
+/// branch grows from the joint; `joints` is working memory.
 ///
 /// The reference vectors of all but the first ring are left to [`carry_references`].
+#[allow(clippy::too_many_arguments)]
 pub(super) fn push_chain_rings(
+    rings: &mut Vec<Ring>,
+    geometry: &[NodeGeom],
+    tube: Option<&ParentTube>,
+    chain_nodes: &[u32],
+    anchors: &[bool],
+    params: &MeshParams,
+    tile_length: f32,
+    ambient: AmbientFn,
+    joints: &mut Vec<u32>,
+) {
+    let first_ring = rings.len();
+    joints.clear();
+    push_rings(
+        rings,
+        geometry,
+        tube,
+        chain_nodes,
+        params,
+        tile_length,
+        ambient,
+        joints,
+    );
+    let tolerances = (params.ring_tolerance, params.ring_tolerance_m);
+    if (tolerances.0 > 0.0 || tolerances.1 > 0.0) && rings.len() - first_ring > 3 {
+        simplify_chain(rings, first_ring, joints, anchors, tolerances);
+    }
+}
+
+/// Leaves out the rings of `rings[first..]` (one chain; ring `first + 1 + k` sits at the end
+/// of internode `joints[k]`) whose centre lies within `tolerance` × its radius, or within
+/// `tolerance_m` metres, of the segment between the rings kept before and after it, greedily
+/// from the base; keeps the first two rings, the tip and the rings at `anchors`' joints. The
+/// rings kept move down in place.
+fn simplify_chain(
+    rings: &mut Vec<Ring>,
+    first: usize,
+    joints: &[u32],
+    anchors: &[bool],
+    (tolerance, tolerance_m): (f32, f32),
+) {
+    /// Most rings left out in a row: bounds the work per ring and the length of a segment.
+    const MAX_RUN: usize = 8;
+    let end = rings.len();
+    let is_anchor = |ring: usize| {
+        joints
+            .get(ring - first - 1)
+            .is_none_or(|&node| anchors.get(node as usize).copied().unwrap_or(true))
+    };
+    // The base (laid onto the parent) and the ring above it stay.
+    let mut kept = first + 1;
+    let mut write = first + 2;
+    for candidate in first + 2..end {
+        let last = candidate + 1 == end;
+        let skippable = !last && !is_anchor(candidate) && candidate - kept <= MAX_RUN && {
+            let (a, b) = (rings[kept].center, rings[candidate + 1].center);
+            (kept + 1..=candidate).all(|k| {
+                let ring = &rings[k];
+                distance_to_segment(ring.center, a, b) <= (tolerance * ring.radius).max(tolerance_m)
+            })
+        };
+        if !skippable {
+            // `kept` indexes the original rings (not yet overwritten: write <= candidate).
+            kept = candidate;
+            rings[write] = rings[candidate];
+            write += 1;
+        }
+    }
+    rings.truncate(write);
+}
+
+/// Distance from `p` to the segment from `a` to `b`.
+fn distance_to_segment(p: Vec3, a: Vec3, b: Vec3) -> f32 {
+    let ab = b - a;
+    let t = ((p - a).dot(ab) / ab.length_squared().max(1e-20)).clamp(0.0, 1.0);
+    p.distance(a + ab * t)
+}
+
+/// The rings of one chain, unsimplified, with the internode each ring after the first ends.
+#[allow(clippy::too_many_arguments)]
+fn push_rings(
     rings: &mut Vec<Ring>,
     geometry: &[NodeGeom],
     tube: Option<&ParentTube>,
@@ -94,6 +179,7 @@ pub(super) fn push_chain_rings(
     params: &MeshParams,
     tile_length: f32,
     ambient: AmbientFn,
+    joints: &mut Vec<u32>,
 ) {
     let first = &geometry[0];
     let mut previous = Ring {
@@ -145,6 +231,7 @@ pub(super) fn push_chain_rings(
             ambient: ambient(node.end).clamp(0.0, 1.0),
         };
         rings.push(ring);
+        joints.push(node_index);
         previous = ring;
     }
     if inside_parent {
@@ -196,5 +283,74 @@ pub(super) fn carry_references(
                 *slot = take(rings);
             }
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// Rings of radius 1 cm at `centers`, the joints numbered 0, 1, … after the first ring.
+    fn rings_at(centers: &[Vec3]) -> (Vec<Ring>, Vec<u32>) {
+        let rings = centers
+            .iter()
+            .map(|&center| Ring {
+                center,
+                tangent: Vec3::Y,
+                reference: Vec3::X,
+                binormal: Vec3::Z,
+                radius: 0.01,
+                v: center.y,
+                u_offset: 0.0,
+                ambient: 1.0,
+            })
+            .collect();
+        (rings, (0..centers.len() as u32 - 1).collect())
+    }
+
+    fn kept_heights(rings: &[Ring]) -> Vec<f32> {
+        rings.iter().map(|r| (r.center.y * 10.0).round()).collect()
+    }
+
+    #[test]
+    fn a_straight_chain_keeps_its_base_the_ring_above_and_its_tip_and_a_bend_or_a_branch_stays() {
+        let straight: Vec<Vec3> = (0..10)
+            .map(|k| Vec3::new(0.0, 0.1 * k as f32, 0.0))
+            .collect();
+        let (mut rings, joints) = rings_at(&straight);
+        simplify_chain(&mut rings, 0, &joints, &[false; 9], (0.25, 0.0));
+        assert_eq!(kept_heights(&rings), [0.0, 1.0, 9.0]);
+
+        // A kink of 5 cm at the sixth ring (5 radii off the line) keeps that ring.
+        let mut bent = straight.clone();
+        for p in &mut bent[5..] {
+            p.x += 0.05;
+        }
+        bent[5].x = 0.05;
+        let (mut rings, joints) = rings_at(&bent);
+        simplify_chain(&mut rings, 0, &joints, &[false; 9], (0.25, 0.0));
+        assert!(kept_heights(&rings).contains(&5.0) || kept_heights(&rings).contains(&4.0));
+        assert!(rings.len() < bent.len(), "{} rings", rings.len());
+
+        // A branch growing from the end of internode 3 (ring 4) keeps that ring.
+        let (mut rings, joints) = rings_at(&straight);
+        let mut anchors = [false; 9];
+        anchors[3] = true;
+        simplify_chain(&mut rings, 0, &joints, &anchors, (0.25, 0.0));
+        assert_eq!(kept_heights(&rings), [0.0, 1.0, 4.0, 9.0]);
+    }
+
+    #[test]
+    fn a_tolerance_in_metres_lets_a_thin_twig_lose_rings_its_radius_alone_would_keep() {
+        // A twig of 1 cm radius wavering by 3 mm: over a quarter of its radius, under 4 mm.
+        let wavy: Vec<Vec3> = (0..10)
+            .map(|k| Vec3::new(if k % 2 == 0 { 0.0 } else { 0.003 }, 0.1 * k as f32, 0.0))
+            .collect();
+        let (mut by_radius, joints) = rings_at(&wavy);
+        simplify_chain(&mut by_radius, 0, &joints, &[false; 9], (0.25, 0.0));
+        let (mut by_metres, _) = rings_at(&wavy);
+        simplify_chain(&mut by_metres, 0, &joints, &[false; 9], (0.25, 0.004));
+        assert_eq!(by_radius.len(), wavy.len(), "every ring stays by radius");
+        assert!(by_metres.len() <= 3, "{} rings", by_metres.len());
     }
 }

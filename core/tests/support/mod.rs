@@ -62,101 +62,91 @@ pub fn validate_glb(path: &Path) -> ValidatorReport {
     }
 }
 
-/// The nodes of the levels of detail of a glTF document, finest first: the one node of its one
-/// scene, then the nodes its `MSFT_lod` extension lists (read from the JSON chunk of `glb`).
-pub fn lod_nodes<'a>(document: &'a gltf::Document, glb: &[u8]) -> Vec<gltf::Node<'a>> {
-    assert_eq!(document.scenes().count(), 1, "one scene");
-    let scene = document.scenes().next().expect("a scene");
-    let roots: Vec<gltf::Node> = scene.nodes().collect();
-    assert_eq!(roots.len(), 1, "one tree in the scene");
-    let json_length = u32::from_le_bytes(glb[12..16].try_into().expect("GLB header")) as usize;
-    let json: serde_json::Value =
-        serde_json::from_slice(&glb[20..20 + json_length]).expect("the JSON chunk parses");
-    let finest = roots[0].index();
-    let ids: Vec<usize> = json["nodes"][finest]["extensions"]["MSFT_lod"]["ids"]
-        .as_array()
-        .map(|ids| {
-            ids.iter()
-                .map(|i| i.as_u64().expect("a node id") as usize)
-                .collect()
-        })
-        .unwrap_or_default();
-    let mut nodes = vec![roots[0].clone()];
-    nodes.extend(
-        ids.into_iter()
-            .map(|i| document.nodes().nth(i).expect("an LOD node")),
-    );
-    nodes
+/// The JSON document and the BIN chunk of a binary glTF file.
+pub fn glb_chunks(path: &Path) -> (serde_json::Value, Vec<u8>) {
+    let glb = std::fs::read(path).expect("the glb reads");
+    let word = |at: usize| u32::from_le_bytes(glb[at..at + 4].try_into().expect("a word")) as usize;
+    assert_eq!(word(0), 0x4654_6C67, "GLB magic");
+    let json_length = word(12);
+    let json = serde_json::from_slice(&glb[20..20 + json_length]).expect("the JSON chunk parses");
+    let bin_start = 20 + json_length;
+    let bin_length = word(bin_start);
+    (
+        json,
+        glb[bin_start + 8..bin_start + 8 + bin_length].to_vec(),
+    )
 }
 
-/// Re-imports `path` with the `gltf` crate and checks, per level of detail (the scene's one
-/// node and its `MSFT_lod` levels), the triangle count and bounds against `meshes`, plus
-/// textured bark and leaf materials.
+/// The bytes of buffer view `view` of a GLB's BIN chunk.
+pub fn view_bytes<'a>(json: &serde_json::Value, bin: &'a [u8], view: usize) -> &'a [u8] {
+    let view = &json["bufferViews"][view];
+    let offset = view["byteOffset"].as_u64().unwrap_or(0) as usize;
+    let length = view["byteLength"].as_u64().expect("a view length") as usize;
+    &bin[offset..offset + length]
+}
+
+/// Re-reads `path` with glTF Transform (a real reader that dequantizes attributes and expands
+/// instances) and checks, per level of detail (the scene's one node and the nodes its
+/// `MSFT_lod` lists), the triangles drawn (mesh triangles times instances, the leaf cards'
+/// included) and the bounds of everything drawn against `meshes` (within the quantization's
+/// step), plus textured bark and leaf materials and their two images.
 pub fn assert_reimport_matches(path: &Path, meshes: &TreeMeshes) {
-    let (document, buffers, images) = gltf::import(path).expect("the glb imports");
-    let glb = std::fs::read(path).expect("the glb reads");
-    let levels = lod_nodes(&document, &glb);
+    let report = read_glb_with_gltf_transform(path);
+    let levels = report["levels"].as_array().expect("levels");
     assert_eq!(
         levels.len(),
         meshes.lods.len(),
         "a node per level of detail"
     );
-    assert_eq!(document.default_scene().map(|s| s.index()), Some(0));
+    assert_eq!(report["default_scene"], 0);
     for (level, node) in levels.iter().enumerate() {
-        let mut triangles = 0;
-        let mut lo = glam::Vec3::splat(f32::INFINITY);
-        let mut hi = glam::Vec3::splat(f32::NEG_INFINITY);
-        let mesh = node.mesh().expect("a mesh per level");
-        for primitive in mesh.primitives() {
-            let reader = primitive.reader(|b| Some(&buffers[b.index()]));
-            triangles += reader.read_indices().expect("indexed").into_u32().count() / 3;
-            let positions: Vec<[f32; 3]> = reader.read_positions().expect("positions").collect();
-            assert!(reader.read_normals().is_some());
-            // Only textured parts carry texture coordinates (the fruit has none).
-            let textured = primitive
-                .material()
-                .pbr_metallic_roughness()
-                .base_color_texture()
-                .is_some();
-            assert_eq!(reader.read_tex_coords(0).is_some(), textured);
-            for p in positions {
-                lo = lo.min(p.into());
-                hi = hi.max(p.into());
-            }
-        }
         assert_eq!(
-            triangles,
-            meshes.num_triangles(level),
+            node["drawn_triangles"].as_u64(),
+            Some(meshes.num_triangles(level) as u64),
             "LOD{level} triangles"
         );
         let (expected_lo, expected_hi) = meshes.bounds(level).expect("bounds");
+        let corner = |key: &str| -> Vec3 {
+            let v = node[key].as_array().expect("a bound");
+            Vec3::from([0, 1, 2].map(|i| v[i].as_f64().expect("a number") as f32))
+        };
+        let (lo, hi) = (corner("min"), corner("max"));
+        // Positions are quantized to 1/32767 of the tree's half extent.
+        let step = (expected_hi - expected_lo).max_element() / 32_767.0;
         assert!(
-            lo.abs_diff_eq(expected_lo, 1e-6) && hi.abs_diff_eq(expected_hi, 1e-6),
-            "LOD{level} bounds"
+            lo.abs_diff_eq(expected_lo, 2.0 * step + 1e-5)
+                && hi.abs_diff_eq(expected_hi, 2.0 * step + 1e-5),
+            "LOD{level} bounds {lo}..{hi} against {expected_lo}..{expected_hi}"
         );
     }
+    let (json, bin) = glb_chunks(path);
     let material = |name: &str| {
-        document
-            .materials()
-            .find(|m| m.name() == Some(name))
+        json["materials"]
+            .as_array()
+            .expect("materials")
+            .iter()
+            .find(|m| m["name"] == name)
             .unwrap_or_else(|| panic!("no {name} material"))
+            .clone()
     };
     let leaf = material("leaf");
     assert!(
-        leaf.pbr_metallic_roughness().base_color_texture().is_some(),
+        leaf["pbrMetallicRoughness"]["baseColorTexture"].is_object(),
         "leaf texture"
     );
-    assert_eq!(leaf.alpha_mode(), gltf::material::AlphaMode::Mask);
+    assert_eq!(leaf["alphaMode"], "MASK");
     assert!(
-        material("bark")
-            .pbr_metallic_roughness()
-            .base_color_texture()
-            .is_some(),
+        material("bark")["pbrMetallicRoughness"]["baseColorTexture"].is_object(),
         "bark texture"
     );
     assert!(meshes.leaves.num_triangles() > 0, "the tree has leaves");
+    let images = json["images"].as_array().expect("images");
     assert_eq!(images.len(), 2, "bark and leaf images");
-    assert!(images.iter().all(|i| i.width >= 64 && i.height >= 64));
+    for image in images {
+        let view = image["bufferView"].as_u64().expect("an embedded image") as usize;
+        let decoded = image::load_from_memory(view_bytes(&json, &bin, view)).expect("a PNG");
+        assert!(decoded.width() >= 64 && decoded.height() >= 64);
+    }
 }
 
 /// The parent's tube around the branching point as the rings define it: closest point on the
@@ -244,9 +234,9 @@ pub fn lowest_y(mesh: &sylva_core::geometry::TreeMesh) -> f32 {
 /// skipped silently.
 pub fn read_glb_with_gltf_transform(path: &Path) -> serde_json::Value {
     let script = workspace_root().join("tools/gltf-reader/read.mjs");
-    let package = workspace_root().join("tools/gltf-reader/node_modules/@gltf-transform/core");
+    let package = workspace_root().join("tools/gltf-reader/node_modules/@gltf-transform");
     assert!(
-        package.is_dir(),
+        package.join("core").is_dir() && package.join("extensions").is_dir(),
         "glTF Transform is not installed: run `bash scripts/setup.sh` (npm install in \
          tools/gltf-reader)"
     );
