@@ -38,10 +38,11 @@ const externalResourceFunction = (uri) =>
 validator
   .validateBytes(bytes, { uri: file, maxIssues: 1000, externalResourceFunction })
   .then((report) => {
-    console.log(JSON.stringify(report, null, 2));
-    process.exit(report.issues.numErrors > 0 ? 1 : 0);
+    // exitCode, not exit(): exit() cuts a long report short when stdout is a pipe.
+    process.stdout.write(JSON.stringify(report, null, 2) + '\n');
+    process.exitCode = report.issues.numErrors > 0 ? 1 : 0;
   })
   .catch((e) => {
     console.error(`validator failed on ${file}: ${e}`);
-    process.exit(2);
+    process.exitCode = 2;
   });
