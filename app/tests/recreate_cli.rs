@@ -288,7 +288,7 @@ fn check_measures(footage: &Path, run: &Run, height_tol: f64, full: bool) {
 }
 
 #[test]
-fn tree_a_from_three_outlines_measures_height_width_and_crown_base() {
+fn tree_a_from_three_outlines_measures_height_width_and_crown_base_and_regrows_after_a_cut() {
     let (_guard, dir) = work_dir("tree_a_three");
     let footage = data("tree_a");
     let marks = write_marks(&dir, &footage, 90, &[15, 90, 165]);
@@ -298,6 +298,66 @@ fn tree_a_from_three_outlines_measures_height_width_and_crown_base() {
     let unmarked = mean_iou(&run, &footage, &[40, 60, 120, 140]);
     println!(
         "tree_a: IoU against the true masks: marked views {marked:.3}, unmarked {unmarked:.3}"
+    );
+    prune_a_main_limb_and_grow_ten_years(&dir.join("tree.json"));
+}
+
+/// The recreated tree is an ordinary tree: cut its largest main limb, grow 10 years, and the crown
+/// regrows into the gap (more internodes there than right after the cut), though less than the
+/// tree grown 10 years without the cut.
+fn prune_a_main_limb_and_grow_ten_years(tree_file: &Path) {
+    use sylva_core::Tree;
+    let tree = Tree::load(tree_file).expect("the recreated tree loads");
+    let nodes = &tree.skeleton.internodes;
+    // Main limbs: the lateral children of the trunk; the largest by internodes that is not the
+    // crown's top (at most a quarter of the tree).
+    let subtree_size = |root: sylva_core::NodeId| {
+        let flags = tree.skeleton.subtree_flags(&[root]);
+        flags.iter().filter(|&&f| f).count()
+    };
+    let limb = nodes
+        .iter()
+        .filter(|n| n.order == 0)
+        .flat_map(|n| n.lateral_children.iter().copied())
+        .filter(|&id| subtree_size(id) * 4 <= nodes.len())
+        .max_by_key(|&id| subtree_size(id))
+        .expect("the trunk has limbs");
+    let flags = tree.skeleton.subtree_flags(&[limb]);
+    let gap: Vec<glam::Vec3> = nodes
+        .iter()
+        .zip(&flags)
+        .filter(|(_, f)| **f)
+        .map(|(n, _)| n.end)
+        .collect();
+    assert!(gap.len() >= 10, "a main limb of {} internodes", gap.len());
+    let in_gap = |t: &Tree| {
+        t.skeleton
+            .internodes
+            .iter()
+            .filter(|n| gap.iter().any(|g| g.distance(n.end) < 0.25))
+            .count()
+    };
+    let mut cut = tree.clone();
+    let pick = nodes[limb.index()].end;
+    let pruned = sylva_core::edit::prune::prune_at(&mut cut, pick).expect("prune");
+    assert!(pruned.num_removed >= gap.len() / 2, "{pruned:?}");
+    let after_cut = in_gap(&cut);
+    let mut regrown = cut.clone();
+    regrown.grow_years(10.0);
+    let mut unpruned = tree.clone();
+    unpruned.grow_years(10.0);
+    let (regrown_n, unpruned_n) = (in_gap(&regrown), in_gap(&unpruned));
+    println!(
+        "prune: limb of {} internodes; in the gap: {after_cut} after the cut, {regrown_n} after 10 years, {unpruned_n} unpruned",
+        gap.len()
+    );
+    assert!(
+        regrown_n > after_cut,
+        "no regrowth into the gap: {regrown_n} internodes after 10 years, {after_cut} after the cut"
+    );
+    assert!(
+        regrown_n < unpruned_n,
+        "the cut tree has as much in the gap ({regrown_n}) as the unpruned one ({unpruned_n})"
     );
 }
 

@@ -19,7 +19,7 @@ struct HullScene<'a> {
     hull: &'a Hull,
     world_from_tree: Affine3A,
     height_m: f32,
-    crown_base_m: f32,
+    /// The trunk's free column around the axis (m), from the ground up.
     trunk_column_m: f32,
 }
 
@@ -29,7 +29,7 @@ impl Scene for HullScene<'_> {
             return false;
         }
         let horizontal = Vec3::new(point_in_tree.x, 0.0, point_in_tree.z).length();
-        if point_in_tree.y <= self.crown_base_m + 0.3 && horizontal <= self.trunk_column_m {
+        if horizontal <= self.trunk_column_m {
             return true;
         }
         let world = self.world_from_tree.transform_point3(point_in_tree);
@@ -50,6 +50,9 @@ pub struct GrowthReport {
     pub attraction_points: usize,
 }
 
+/// Leaf cards reach about this far beyond the twigs that carry them (m): the envelope growth
+/// fills is the hull shrunk by it, so the foliage ends near the hull's surface.
+const LEAF_REACH_M: f64 = 0.1;
 /// Attraction points sampled in the hull (at most).
 const HULL_POINTS: usize = 6000;
 /// A hull cell counts as filled when an internode ends within this many internode lengths.
@@ -57,8 +60,8 @@ const FILL_REACH_INTERNODES: f32 = 3.0;
 /// Growth stops once this fraction of the hull is filled ...
 const FILLED: f32 = 0.9;
 /// ... or it gained less than this over the last few iterations.
-const MIN_GAIN: f32 = 0.01;
-const GAIN_WINDOW: usize = 4;
+const MIN_GAIN: f32 = 0.005;
+const GAIN_WINDOW: usize = 5;
 
 /// The tree placed at the trunk base, upright on the ground.
 pub fn world_from_tree(base: DVec3, up: DVec3) -> Affine3A {
@@ -202,11 +205,16 @@ pub fn grow_into_hull(
     let world_from_tree = world_from_tree(recreation.base, up);
     let tree_from_world = world_from_tree.inverse();
     let m = &recreation.measurements;
+    let envelope = recreation.hull.eroded(LEAF_REACH_M);
+    let envelope = if envelope.num_voxels() > 0 {
+        envelope
+    } else {
+        recreation.hull.clone()
+    };
     let scene = HullScene {
-        hull: &recreation.hull,
+        hull: &envelope,
         world_from_tree,
         height_m: m.height_m as f32,
-        crown_base_m: m.crown_base_m as f32,
         trunk_column_m: 0.0,
     };
     let mut tree = Tree::new(species, seed);
@@ -215,8 +223,7 @@ pub fn grow_into_hull(
         ..scene
     };
     let crown_base_m = m.crown_base_m as f32;
-    let hull_in_tree: Vec<Vec3> = recreation
-        .hull
+    let hull_in_tree: Vec<Vec3> = envelope
         .voxels()
         .into_iter()
         .map(|p| tree_from_world.transform_point3(p.as_vec3()))
@@ -224,7 +231,7 @@ pub fn grow_into_hull(
     // Attraction points: voxel centres of the hull (an even subset, jittered within the voxel),
     // and the tree's own points.
     let stride = hull_in_tree.len().div_ceil(HULL_POINTS).max(1);
-    let voxel_m = recreation.hull.voxel_m as f32;
+    let voxel_m = envelope.voxel_m as f32;
     let mut num_points = 0;
     for p in hull_in_tree.iter().step_by(stride) {
         let jitter = Vec3::new(
@@ -246,6 +253,8 @@ pub fn grow_into_hull(
     let max_iterations = tree.species.iterations_for_years(max_years).max(1);
     let mut history: Vec<f32> = Vec::new();
     let mut filled = 0.0;
+    // Shedding may take back what a few iterations filled: the fullest tree is kept.
+    let mut best: Option<(f32, Tree)> = None;
     for _ in 0..max_iterations {
         tree.step(StepOptions {
             autonomous: true,
@@ -254,13 +263,20 @@ pub fn grow_into_hull(
         lift_crown(&mut tree, crown_base_m);
         filled = grid.filled(&tree, reach_m);
         history.push(filled);
-        // Early on the seedling is still climbing the trunk's column: no stall before a quarter.
-        let stalled = filled > 0.25
+        if best.as_ref().is_none_or(|(f, _)| filled > *f) {
+            best = Some((filled, tree.clone()));
+        }
+        // Early on the seedling is still climbing the trunk's column: no stall before half.
+        let stalled = filled > 0.5
             && history.len() > GAIN_WINDOW
             && filled - history[history.len() - 1 - GAIN_WINDOW] < MIN_GAIN;
         if filled >= FILLED || stalled {
             break;
         }
+    }
+    if let Some((best_filled, best_tree)) = best {
+        (filled, tree) = (best_filled, best_tree);
+        tree.update_widths();
     }
     let report = GrowthReport {
         species: tree.species.name.clone(),

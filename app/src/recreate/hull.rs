@@ -209,6 +209,36 @@ impl Hull {
         }
     }
 
+    /// The hull shrunk by `margin_m`: voxels whose whole neighbourhood of that radius (a cube)
+    /// is in the hull. Growth fills this one, so leaves on the outermost twigs stay inside.
+    pub fn eroded(&self, margin_m: f64) -> Hull {
+        let r = (margin_m / self.voxel_m).round().max(0.0) as usize;
+        let [nx, ny, nz] = self.dims;
+        let mut occupied = vec![false; self.occupied.len()];
+        for k in r..nz.saturating_sub(r) {
+            for j in 0..ny {
+                for i in r..nx.saturating_sub(r) {
+                    if !self.occupied[self.index(i, j, k)] {
+                        continue;
+                    }
+                    // Not eroded from below: the crown's base is measured, the ground is not a
+                    // boundary of the crown's envelope.
+                    let j_high = (j + r).min(ny - 1);
+                    let kept = (k - r..=k + r).all(|kk| {
+                        (j..=j_high).all(|jj| {
+                            (i - r..=i + r).all(|ii| self.occupied[self.index(ii, jj, kk)])
+                        })
+                    });
+                    occupied[self.index(i, j, k)] = kept;
+                }
+            }
+        }
+        Hull {
+            occupied,
+            ..self.clone()
+        }
+    }
+
     /// Whether the hull touches the sides or top of its box (the box was too small).
     pub fn touches_box(&self) -> bool {
         let [nx, ny, nz] = self.dims;
