@@ -4,7 +4,9 @@
 //! Layout written (see `test-data/README.md`): `rgb/` frames + `rgb.txt`, `depth/` 16-bit PNG
 //! (metres × 5000) + `depth.txt`, `groundtruth.txt` (`timestamp tx ty tz qx qy qz qw`,
 //! `world_from_camera`, OpenCV camera axes), `accelerometer.txt`, `camera.txt` and
-//! `scene.json` (the analytic scene and the options used).
+//! `scene.json` (the analytic scene and the options used). The tree presets (`tree-a`, `tree-b`)
+//! add a grammar tree at the spot ([`tree`]), its silhouette masks (`masks/`, `masks.txt`) and its
+//! true measures (`tree_truth.json`).
 //!
 //! World space: metres, Y up, the planting spot at the origin on the ground.
 
