@@ -366,6 +366,31 @@ mod tests {
     }
 
     #[test]
+    fn the_mask_top_row_is_where_the_true_height_projects() {
+        use crate::synthetic::render::{MASK_FOLIAGE, Pinhole, render_tree_mask};
+        let tree = SynthTree::new(TreeParams::tree_a());
+        let truth = tree.truth();
+        let camera = Pinhole::tum_default(320, 240);
+        // Level camera 8 m away on +Z looking at the tree (camera Y down, Z forward = −Z).
+        let rotation = glam::Mat3::from_cols(Vec3::X, Vec3::NEG_Y, Vec3::NEG_Z);
+        let pose = glam::Affine3A::from_mat3_translation(rotation, Vec3::new(0.0, 1.6, 8.0));
+        let mask = render_tree_mask(&tree, &camera, &pose);
+        let top_row = (0..240)
+            .find(|&r| (0..320).any(|c| mask[r * 320 + c] == MASK_FOLIAGE))
+            .expect("foliage in view");
+        // The highest point lies within the crown's half-width of the trunk axis in depth.
+        let row_at = |depth_m: f32| camera.cy - camera.fy * (truth.height_m - 1.6) / depth_m;
+        let (near, far) = (
+            row_at(8.0 - 0.5 * truth.crown_width_m),
+            row_at(8.0 + 0.5 * truth.crown_width_m),
+        );
+        assert!(
+            (near - 1.0..=far + 1.0).contains(&(top_row as f32)),
+            "top row {top_row}, the true height projects to rows {near:.1}..{far:.1}"
+        );
+    }
+
+    #[test]
     fn the_same_seed_grows_the_same_tree() {
         let a = SynthTree::new(TreeParams::tree_a()).truth();
         let b = SynthTree::new(TreeParams::tree_a()).truth();
