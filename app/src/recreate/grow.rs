@@ -176,16 +176,34 @@ impl FillGrid {
     }
 }
 
-/// Crown lifting, as the real tree has it: removes the branches the trunk grew below the crown
-/// base (the hull leaves room for the trunk only). Returns how many internodes went.
+/// Crown lifting, as the real tree has it: below the crown base the trunk keeps one axis. From
+/// the base up, the trunk continues into the child carrying the most internodes (a lateral that
+/// took over the lead is the trunk then); its other children below the crown base are removed.
+/// Returns how many internodes went.
 pub fn lift_crown(tree: &mut Tree, crown_base_m: f32) -> usize {
-    let roots: Vec<_> = tree
-        .skeleton
-        .internodes
-        .iter()
-        .filter(|n| n.order == 0 && n.end.y < crown_base_m)
-        .flat_map(|n| n.lateral_children.iter().copied())
-        .collect();
+    let nodes = &tree.skeleton.internodes;
+    if nodes.is_empty() {
+        return 0;
+    }
+    // The arena is topological (parents first): subtree sizes in one backward pass.
+    let mut size = vec![1usize; nodes.len()];
+    for i in (0..nodes.len()).rev() {
+        if let Some(parent) = nodes[i].parent {
+            size[parent.index()] += size[i];
+        }
+    }
+    let mut roots = Vec::new();
+    let mut node = sylva_core::NodeId(0);
+    while nodes[node.index()].end.y < crown_base_m {
+        let Some(trunk) = nodes[node.index()]
+            .children()
+            .max_by_key(|c| size[c.index()])
+        else {
+            break;
+        };
+        roots.extend(nodes[node.index()].children().filter(|&c| c != trunk));
+        node = trunk;
+    }
     if roots.is_empty() {
         0
     } else {
@@ -287,4 +305,36 @@ pub fn grow_into_hull(
         attraction_points: num_points,
     };
     (tree, world_from_tree, report)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn crown_lifting_leaves_one_axis_below_the_crown_base() {
+        let species = Species::by_name("oak").expect("oak preset");
+        let mut tree = Tree::new(species, 3);
+        tree.grow_years(6.0);
+        let before = tree.skeleton.len();
+        let removed = lift_crown(&mut tree, 1.0);
+        assert!(removed > 0 && tree.skeleton.len() == before - removed);
+        let low: Vec<_> = tree
+            .skeleton
+            .internodes
+            .iter()
+            .filter(|n| n.end.y < 1.0)
+            .collect();
+        let branching = low
+            .iter()
+            .filter(|n| {
+                n.children()
+                    .filter(|c| tree.skeleton.get(*c).end.y < 1.0)
+                    .count()
+                    > 1
+            })
+            .count();
+        assert_eq!(branching, 0, "a branching point below the crown base");
+        assert!(tree.sanity_check().is_ok());
+    }
 }
