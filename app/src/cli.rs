@@ -24,6 +24,9 @@ pub enum Command {
     View(crate::cmd_app::ViewArgs),
     /// Tracks a recorded sequence; prints timings and a key=value accuracy line.
     Track(crate::cmd_track::TrackArgs),
+    /// Recreates an existing tree from footage and marks: measures it and grows a model into
+    /// it; ends with a key=value summary line.
+    Recreate(crate::cmd_recreate::RecreateArgs),
 }
 
 pub fn main() -> anyhow::Result<()> {
@@ -35,6 +38,7 @@ pub fn main() -> anyhow::Result<()> {
         Some(Command::Replay(args)) => crate::cmd_app::replay_command(args),
         Some(Command::View(args)) => crate::cmd_app::view(args),
         Some(Command::Track(args)) => crate::cmd_track::track(args),
+        Some(Command::Recreate(args)) => crate::cmd_recreate::recreate(args),
         None => crate::cmd_app::demo(),
     }
 }

@@ -4,7 +4,9 @@
 //! Layout written (see `test-data/README.md`): `rgb/` frames + `rgb.txt`, `depth/` 16-bit PNG
 //! (metres × 5000) + `depth.txt`, `groundtruth.txt` (`timestamp tx ty tz qx qy qz qw`,
 //! `world_from_camera`, OpenCV camera axes), `accelerometer.txt`, `camera.txt` and
-//! `scene.json` (the analytic scene and the options used).
+//! `scene.json` (the analytic scene and the options used). The tree presets (`tree-a`, `tree-b`)
+//! add a grammar tree at the spot ([`tree`]), its silhouette masks (`masks/`, `masks.txt`) and its
+//! true measures (`tree_truth.json`).
 //!
 //! World space: metres, Y up, the planting spot at the origin on the ground.
 
@@ -13,6 +15,8 @@ mod rng;
 pub mod scene;
 pub mod texture;
 pub mod trajectory;
+pub mod tree;
+pub mod tree_bvh;
 mod writer;
 
 use std::ops::Range;
@@ -24,6 +28,7 @@ use serde::Serialize;
 pub use render::{Exposure, Pinhole};
 pub use scene::{Block, Garden, Ground};
 pub use trajectory::{Walk, WalkParams};
+pub use tree::{SynthTree, TreeParams, TreeTruth};
 
 /// Errors while writing a sequence.
 #[derive(Debug, thiserror::Error)]
@@ -66,6 +71,44 @@ pub struct SequenceOptions {
     pub depth_every: usize,
     /// Accelerometer samples per second.
     pub accelerometer_hz: f64,
+    /// A grammar tree at the planting spot (the tree presets): its garden, silhouette masks per
+    /// frame (`masks/`) and its true measures (`tree_truth.json`).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub tree: Option<TreePreset>,
+}
+
+/// The tree presets' trees and their gardens.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum TreePreset {
+    /// Tree A on an open lawn (the paved path beside it, no wall or box).
+    OpenLawn,
+    /// Tree B with a brick wall 3 m behind it.
+    WallBehind,
+}
+
+impl TreePreset {
+    pub fn params(self) -> TreeParams {
+        match self {
+            Self::OpenLawn => TreeParams::tree_a(),
+            Self::WallBehind => TreeParams::tree_b(),
+        }
+    }
+
+    fn blocks(self, ground: Ground) -> Vec<Block> {
+        match self {
+            Self::OpenLawn => Vec::new(),
+            Self::WallBehind => {
+                let base = ground.height_at(0.0, -3.0).max(ground.height_at(0.0, -3.2));
+                vec![Block {
+                    name: "wall",
+                    min: glam::Vec3::new(-4.5, base - 3.0, -3.2),
+                    max: glam::Vec3::new(4.5, base + 1.8, -3.0),
+                    material: scene::BlockMaterial::Brick,
+                }]
+            }
+        }
+    }
 }
 
 impl SequenceOptions {
@@ -88,6 +131,44 @@ impl SequenceOptions {
             frame_format: FrameFormat::Jpeg { quality: 75 },
             depth_every: 10,
             accelerometer_hz: 120.0,
+            tree: None,
+        }
+    }
+
+    /// Tree A (`test-data/tree_a`): the camera circles a 3 m grammar tree on an open lawn at
+    /// 7 m, 80° of arc in 180 frames, pitched 4° down so the whole tree stays in view.
+    pub fn tree_a() -> Self {
+        Self {
+            seed: 2031,
+            num_frames: 180,
+            walk: WalkParams {
+                radius_m: 7.0,
+                height_m: 1.5,
+                pitch_deg: 4.0,
+                start_bearing_deg: -40.0,
+                end_bearing_deg: 40.0,
+                ..WalkParams::default()
+            },
+            motion_blur: false,
+            frame_format: FrameFormat::Jpeg { quality: 60 },
+            depth_every: 0,
+            tree: Some(TreePreset::OpenLawn),
+            ..Self::demo_garden()
+        }
+    }
+
+    /// Tree B (`test-data/tree_b`): a 3.3 m ovoid grammar tree with a wall behind it, circled the
+    /// other way round.
+    pub fn tree_b() -> Self {
+        Self {
+            seed: 2032,
+            walk: WalkParams {
+                start_bearing_deg: 40.0,
+                end_bearing_deg: -40.0,
+                ..Self::tree_a().walk
+            },
+            tree: Some(TreePreset::WallBehind),
+            ..Self::tree_a()
         }
     }
 
@@ -215,7 +296,10 @@ pub fn render_sequence(
     options.validate()?;
     let camera = Pinhole::tum_default(options.width, options.height);
     let ground = Ground::sloped(options.slope_deg);
-    let garden = Garden::new(ground, (options.seed as u32) ^ 0x6a4d);
+    let mut garden = Garden::new(ground, (options.seed as u32) ^ 0x6a4d);
+    if let Some(preset) = options.tree {
+        garden = garden.with_tree(preset.blocks(ground), SynthTree::new(preset.params()));
+    }
     let walk = Walk::new(
         options.walk.clone(),
         ground,
@@ -246,6 +330,10 @@ pub fn render_sequence(
             render::render_rgb(&garden, &camera, &exposure)
         };
         out.frame(timestamp_s, &rgb, &world_from_camera)?;
+        if let Some(tree) = &garden.tree {
+            let mask = render::render_tree_mask(tree, &camera, &world_from_camera);
+            out.mask(timestamp_s, &mask)?;
+        }
         if options.depth_every > 0 && index % options.depth_every == 0 {
             let depth_m = render::render_depth_m(&garden, &camera, &world_from_camera);
             out.depth(timestamp_s, &depth_m)?;

@@ -137,6 +137,37 @@ pub fn render_depth_m(garden: &Garden, camera: &Pinhole, world_from_camera: &Aff
     depth
 }
 
+/// Value of a tree-mask pixel showing foliage, and wood (0 = not the tree).
+pub const MASK_FOLIAGE: u8 = 255;
+pub const MASK_WOOD: u8 = 128;
+
+/// The tree's silhouette for one pose, one ray per pixel centre (nothing in the gardens stands
+/// between the walk and the tree): [`MASK_FOLIAGE`], [`MASK_WOOD`] or 0 per pixel, row-major.
+pub fn render_tree_mask(
+    tree: &super::SynthTree,
+    camera: &Pinhole,
+    world_from_camera: &Affine3A,
+) -> Vec<u8> {
+    let (width, height) = (camera.width as usize, camera.height as usize);
+    let origin: Vec3 = world_from_camera.translation.into();
+    let mut mask = vec![0u8; width * height];
+    mask.par_chunks_mut(width)
+        .enumerate()
+        .for_each(|(row, line)| {
+            for (column, value) in line.iter_mut().enumerate() {
+                let ray = camera.ray_in_camera(column as f32, row as f32);
+                let direction = world_from_camera.transform_vector3(ray);
+                if let Some(hit) = tree.bvh.intersect(origin, direction, MAX_DISTANCE_M) {
+                    *value = match hit.part {
+                        super::tree::TreePart::Foliage => MASK_FOLIAGE,
+                        super::tree::TreePart::Wood => MASK_WOOD,
+                    };
+                }
+            }
+        });
+    mask
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -8,6 +8,8 @@ use glam::{Vec2, Vec3};
 use serde::Serialize;
 
 use super::texture;
+use super::tree::SynthTree;
+use super::tree_bvh::TreeHit;
 
 /// What a block is made of.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
@@ -64,6 +66,8 @@ pub struct Hit {
     pub normal: Vec3,
     /// `None` for the ground, else the index of the block.
     pub block: Option<usize>,
+    /// Set when the ray hit the garden's tree (then `block` is `None`).
+    pub tree: Option<TreeHit>,
 }
 
 /// The whole analytic scene.
@@ -75,6 +79,9 @@ pub struct Garden {
     pub sun_direction: Vec3,
     #[serde(skip)]
     pub texture_seed: u32,
+    /// A grammar tree standing at the planting spot (the tree presets).
+    #[serde(skip)]
+    pub tree: Option<std::sync::Arc<SynthTree>>,
 }
 
 impl Garden {
@@ -102,7 +109,15 @@ impl Garden {
             blocks,
             sun_direction: Vec3::new(0.45, 0.8, 0.35).normalize(),
             texture_seed,
+            tree: None,
         }
+    }
+
+    /// The garden with `blocks` instead of the standard wall and box, and `tree` at the spot.
+    pub fn with_tree(mut self, blocks: Vec<Block>, tree: SynthTree) -> Self {
+        self.blocks = blocks;
+        self.tree = Some(std::sync::Arc::new(tree));
+        self
     }
 
     /// Nearest hit along `origin + t·direction` for `t` in `(0, max_distance)`.
@@ -117,6 +132,7 @@ impl Garden {
                     point: origin + direction * t,
                     normal: self.ground.normal,
                     block: None,
+                    tree: None,
                 });
             }
         }
@@ -128,6 +144,19 @@ impl Garden {
                     point: origin + direction * t,
                     normal,
                     block: Some(index),
+                    tree: None,
+                });
+            }
+        }
+        if let Some(tree) = &self.tree {
+            let limit = best.map_or(max_distance, |hit| hit.distance);
+            if let Some(hit) = tree.bvh.intersect(origin, direction, limit) {
+                best = Some(Hit {
+                    distance: hit.distance,
+                    point: origin + direction * hit.distance,
+                    normal: hit.normal,
+                    block: None,
+                    tree: Some(hit),
                 });
             }
         }
@@ -138,6 +167,10 @@ impl Garden {
     pub fn shade(&self, hit: &Hit, footprint_m: f32) -> Vec3 {
         let seed = self.texture_seed;
         let albedo = match hit.block {
+            None if hit.tree.is_some() => match &hit.tree {
+                Some(tree_hit) => super::tree::albedo(tree_hit, footprint_m, seed),
+                None => Vec3::ZERO,
+            },
             None => self.ground_albedo(hit.point, footprint_m),
             Some(index) => {
                 let block = &self.blocks[index];
@@ -194,6 +227,11 @@ impl Garden {
         self.blocks
             .iter()
             .any(|b| ray_box(point, self.sun_direction, b.min, b.max, 100.0).is_some())
+            || self.tree.as_ref().is_some_and(|tree| {
+                tree.bvh
+                    .intersect(point, self.sun_direction, 100.0)
+                    .is_some()
+            })
     }
 }
 

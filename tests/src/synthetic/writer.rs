@@ -21,6 +21,7 @@ pub struct TumWriter<'a> {
     rgb_list: String,
     depth_list: String,
     groundtruth: String,
+    mask_list: String,
     total_bytes: u64,
 }
 
@@ -37,12 +38,17 @@ impl<'a> TumWriter<'a> {
             let dir = root.join(sub);
             fs::create_dir_all(&dir).map_err(|e| write_error(&dir, e))?;
         }
+        if options.tree.is_some() {
+            let dir = root.join("masks");
+            fs::create_dir_all(&dir).map_err(|e| write_error(&dir, e))?;
+        }
         Ok(Self {
             root: root.to_path_buf(),
             options,
             rgb_list: "# color images\n# synthetic garden (sylva-tests make_synthetic)\n# timestamp filename\n".into(),
             depth_list: "# depth maps (uint16 PNG, metres = value / 5000)\n# timestamp filename\n".into(),
             groundtruth: "# ground truth trajectory (world_from_camera, world Y up, metres)\n# timestamp tx ty tz qx qy qz qw\n".into(),
+            mask_list: "# tree silhouette masks (8-bit PNG: 255 foliage, 128 wood, 0 not the tree)\n# timestamp filename\n".into(),
             total_bytes: 0,
         })
     }
@@ -108,6 +114,18 @@ impl<'a> TumWriter<'a> {
         Ok(())
     }
 
+    /// One frame's tree silhouette mask (8-bit grey, see `render::render_tree_mask`).
+    pub fn mask(&mut self, timestamp_s: f64, mask: &[u8]) -> Result<(), SyntheticError> {
+        let (width, height) = (self.options.width, self.options.height);
+        let relative = format!("masks/{timestamp_s:.6}.png");
+        self.save(&relative, |w| {
+            PngEncoder::new_with_quality(w, CompressionType::Best, FilterType::Adaptive)
+                .write_image(mask, width, height, image::ExtendedColorType::L8)
+        })?;
+        let _ = writeln!(self.mask_list, "{timestamp_s:.6} {relative}");
+        Ok(())
+    }
+
     /// One depth map (camera Z in metres, 0 = no measurement).
     pub fn depth(&mut self, timestamp_s: f64, depth_m: &[f32]) -> Result<(), SyntheticError> {
         let (width, height) = (self.options.width, self.options.height);
@@ -152,6 +170,18 @@ impl<'a> TumWriter<'a> {
         self.text("rgb.txt", &rgb_list)?;
         self.text("depth.txt", &depth_list)?;
         self.text("groundtruth.txt", &groundtruth)?;
+        if let Some(tree) = &garden.tree {
+            let mask_list = std::mem::take(&mut self.mask_list);
+            self.text("masks.txt", &mask_list)?;
+            let truth = serde_json::json!({
+                "generator": "sylva-tests make_synthetic (stochastic branching grammar, tests/src/synthetic/tree.rs)",
+                "truth": tree.truth(),
+                "params": tree.params,
+            });
+            let json = serde_json::to_string_pretty(&truth)
+                .map_err(|e| write_error(&self.root.join("tree_truth.json"), e))?;
+            self.text("tree_truth.json", &json)?;
+        }
         let mut accel = String::from(
             "# accelerometer data (m/s^2, specific force: +g upwards at rest)\n\
              # axes as the Kinect of TUM fr1: x = -camera X, y = -camera Y (up), z = camera Z (forward)\n\

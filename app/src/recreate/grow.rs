@@ -1,0 +1,340 @@
+//! Growing the model into the measured tree: the species grows from the trunk base with the
+//! visual hull as its envelope (TreeSketch's lasso envelope, Longay 2014 §5.2.2: attraction
+//! points fill it, and no shoot leaves it: core's grow-in-front scene mode) and the tree's own
+//! points as extra attraction points, until it fills the hull or stops gaining, never above the
+//! measured height. The trunk's narrow column below the crown is free space too, so the trunk
+//! can reach the crown, and branches it grows below the crown base are removed (crown lifting). The result is an ordinary tree in its own space; `world_from_tree` places it.
+
+use glam::{Affine3A, DVec3, Quat, Vec3};
+use sylva_core::Tree;
+use sylva_core::environment::{Scene, SceneMode};
+use sylva_core::growth::StepOptions;
+use sylva_core::species::Species;
+
+use super::hull::Hull;
+use super::measure::Recreation;
+
+/// The hull as core's scene, in tree space.
+struct HullScene<'a> {
+    hull: &'a Hull,
+    world_from_tree: Affine3A,
+    height_m: f32,
+    /// The trunk's free column around the axis (m), from the ground up.
+    trunk_column_m: f32,
+}
+
+impl Scene for HullScene<'_> {
+    fn is_free(&self, point_in_tree: Vec3) -> bool {
+        if point_in_tree.y > self.height_m {
+            return false;
+        }
+        let horizontal = Vec3::new(point_in_tree.x, 0.0, point_in_tree.z).length();
+        if horizontal <= self.trunk_column_m {
+            return true;
+        }
+        let world = self.world_from_tree.transform_point3(point_in_tree);
+        self.hull.contains(world.as_dvec3(), 0)
+    }
+}
+
+/// How the growth went.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct GrowthReport {
+    pub species: String,
+    /// How the species was chosen.
+    pub species_choice: String,
+    pub iterations: u32,
+    pub age_years: f32,
+    /// Fraction of the hull's coarse cells reached by the tree.
+    pub hull_filled: f32,
+    pub attraction_points: usize,
+}
+
+/// Leaf cards reach about this far beyond the twigs that carry them (m): the envelope growth
+/// fills is the hull shrunk by it, so the foliage ends near the hull's surface.
+const LEAF_REACH_M: f64 = 0.1;
+/// Attraction points sampled in the hull (at most).
+const HULL_POINTS: usize = 6000;
+/// A hull cell counts as filled when an internode ends within this many internode lengths.
+const FILL_REACH_INTERNODES: f32 = 3.0;
+/// Growth stops once this fraction of the hull is filled ...
+const FILLED: f32 = 0.9;
+/// ... or it gained less than this over the last few iterations.
+const MIN_GAIN: f32 = 0.005;
+const GAIN_WINDOW: usize = 5;
+
+/// The tree placed at the trunk base, upright on the ground.
+pub fn world_from_tree(base: DVec3, up: DVec3) -> Affine3A {
+    let up = up.as_vec3().try_normalize().unwrap_or(Vec3::Y);
+    Affine3A::from_rotation_translation(Quat::from_rotation_arc(Vec3::Y, up), base.as_vec3())
+}
+
+/// The preset whose proportions (height over spread at 10 years) are closest to the measured ones.
+pub fn closest_species(height_m: f64, crown_width_m: f64) -> (Species, String) {
+    let measured = (height_m / crown_width_m.max(0.1)).ln();
+    let mut best: Option<(f64, Species)> = None;
+    for s in Species::presets() {
+        let e = &s.expected;
+        let ratio = (e.height_10y_m as f64 / e.spread_10y_m.max(0.1) as f64).ln();
+        let d = (ratio - measured).abs();
+        if best.as_ref().is_none_or(|(b, _)| d < *b) {
+            best = Some((d, s));
+        }
+    }
+    let species = best.map(|(_, s)| s).unwrap_or_else(|| {
+        Species::presets()
+            .into_iter()
+            .next()
+            .expect("the species presets are built in")
+    });
+    let e = &species.expected;
+    let why = format!(
+        "closest preset by proportions: measured height/width {:.2}, {} {:.2} at 10 years",
+        height_m / crown_width_m.max(0.1),
+        species.name,
+        e.height_10y_m / e.spread_10y_m
+    );
+    (species, why)
+}
+
+/// Coarse occupancy of the hull, to measure how much of it the tree fills.
+struct FillGrid {
+    min: Vec3,
+    cell_m: f32,
+    dims: [usize; 3],
+    in_hull: Vec<bool>,
+    num_in_hull: usize,
+}
+
+impl FillGrid {
+    fn new(hull_in_tree: &[Vec3], cell_m: f32) -> Self {
+        let (min, max) = hull_in_tree.iter().fold(
+            (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
+            |(lo, hi), p| (lo.min(*p), hi.max(*p)),
+        );
+        let dims = [0, 1, 2].map(|a| (((max[a] - min[a]) / cell_m).floor() as usize + 1).min(512));
+        let mut in_hull = vec![false; dims[0] * dims[1] * dims[2]];
+        let mut grid = Self {
+            min,
+            cell_m,
+            dims,
+            in_hull: Vec::new(),
+            num_in_hull: 0,
+        };
+        for p in hull_in_tree {
+            if let Some(i) = grid.cell(*p) {
+                in_hull[i] = true;
+            }
+        }
+        grid.num_in_hull = in_hull.iter().filter(|&&v| v).count();
+        grid.in_hull = in_hull;
+        grid
+    }
+
+    fn cell(&self, p: Vec3) -> Option<usize> {
+        let c = (p - self.min) / self.cell_m;
+        let ijk = [c.x, c.y, c.z];
+        let mut index = 0;
+        for a in (0..3).rev() {
+            let v = ijk[a].floor();
+            if v < 0.0 || v as usize >= self.dims[a] {
+                return None;
+            }
+            index = index * self.dims[a] + v as usize;
+        }
+        Some(index)
+    }
+
+    /// Fraction of hull cells within `reach_m` of some internode end.
+    fn filled(&self, tree: &Tree, reach_m: f32) -> f32 {
+        if self.num_in_hull == 0 {
+            return 1.0;
+        }
+        let mut reached = vec![false; self.in_hull.len()];
+        let r = (reach_m / self.cell_m).ceil() as i32;
+        for node in &tree.skeleton.internodes {
+            for dz in -r..=r {
+                for dy in -r..=r {
+                    for dx in -r..=r {
+                        let offset = Vec3::new(dx as f32, dy as f32, dz as f32) * self.cell_m;
+                        if offset.length() > reach_m {
+                            continue;
+                        }
+                        if let Some(i) = self.cell(node.end + offset) {
+                            reached[i] = true;
+                        }
+                    }
+                }
+            }
+        }
+        let hit = reached
+            .iter()
+            .zip(&self.in_hull)
+            .filter(|(r, h)| **r && **h)
+            .count();
+        hit as f32 / self.num_in_hull as f32
+    }
+}
+
+/// Crown lifting, as the real tree has it: below the crown base the trunk keeps one axis. From
+/// the base up, the trunk continues into the child carrying the most internodes (a lateral that
+/// took over the lead is the trunk then); its other children below the crown base are removed.
+/// Returns how many internodes went.
+pub fn lift_crown(tree: &mut Tree, crown_base_m: f32) -> usize {
+    let nodes = &tree.skeleton.internodes;
+    if nodes.is_empty() {
+        return 0;
+    }
+    // The arena is topological (parents first): subtree sizes in one backward pass.
+    let mut size = vec![1usize; nodes.len()];
+    for i in (0..nodes.len()).rev() {
+        if let Some(parent) = nodes[i].parent {
+            size[parent.index()] += size[i];
+        }
+    }
+    let mut roots = Vec::new();
+    let mut node = sylva_core::NodeId(0);
+    while nodes[node.index()].end.y < crown_base_m {
+        let Some(trunk) = nodes[node.index()]
+            .children()
+            .max_by_key(|c| size[c.index()])
+        else {
+            break;
+        };
+        roots.extend(nodes[node.index()].children().filter(|&c| c != trunk));
+        node = trunk;
+    }
+    if roots.is_empty() {
+        0
+    } else {
+        tree.remove_subtrees(&roots)
+    }
+}
+
+/// Grows `species` into the recreation's hull; `max_years` bounds the growth.
+pub fn grow_into_hull(
+    species: Species,
+    species_choice: String,
+    seed: u64,
+    recreation: &Recreation,
+    up: DVec3,
+    max_years: f32,
+) -> (Tree, Affine3A, GrowthReport) {
+    let world_from_tree = world_from_tree(recreation.base, up);
+    let tree_from_world = world_from_tree.inverse();
+    let m = &recreation.measurements;
+    let envelope = recreation.hull.eroded(LEAF_REACH_M);
+    let envelope = if envelope.num_voxels() > 0 {
+        envelope
+    } else {
+        recreation.hull.clone()
+    };
+    let scene = HullScene {
+        hull: &envelope,
+        world_from_tree,
+        height_m: m.height_m as f32,
+        trunk_column_m: 0.0,
+    };
+    let mut tree = Tree::new(species, seed);
+    let scene = HullScene {
+        trunk_column_m: (2.0 * tree.species.internode_length_m).max(0.1),
+        ..scene
+    };
+    let crown_base_m = m.crown_base_m as f32;
+    let hull_in_tree: Vec<Vec3> = envelope
+        .voxels()
+        .into_iter()
+        .map(|p| tree_from_world.transform_point3(p.as_vec3()))
+        .collect();
+    // Attraction points: voxel centres of the hull (an even subset, jittered within the voxel),
+    // and the tree's own points.
+    let stride = hull_in_tree.len().div_ceil(HULL_POINTS).max(1);
+    let voxel_m = envelope.voxel_m as f32;
+    let mut num_points = 0;
+    for p in hull_in_tree.iter().step_by(stride) {
+        let jitter = Vec3::new(
+            tree.rng.range_f32(-0.5, 0.5),
+            tree.rng.range_f32(-0.5, 0.5),
+            tree.rng.range_f32(-0.5, 0.5),
+        ) * voxel_m;
+        tree.environment.attraction.add_persistent(*p + jitter);
+        num_points += 1;
+    }
+    for p in &recreation.own_points {
+        tree.environment
+            .attraction
+            .add_persistent(tree_from_world.transform_point3(p.as_vec3()));
+        num_points += 1;
+    }
+    let reach_m = FILL_REACH_INTERNODES * tree.species.internode_length_m;
+    let grid = FillGrid::new(&hull_in_tree, (reach_m * 0.5).max(voxel_m));
+    let max_iterations = tree.species.iterations_for_years(max_years).max(1);
+    let mut history: Vec<f32> = Vec::new();
+    let mut filled = 0.0;
+    // Shedding may take back what a few iterations filled: the fullest tree is kept.
+    let mut best: Option<(f32, Tree)> = None;
+    for _ in 0..max_iterations {
+        tree.step(StepOptions {
+            autonomous: true,
+            scene: Some((&scene, SceneMode::GrowInFront)),
+        });
+        lift_crown(&mut tree, crown_base_m);
+        filled = grid.filled(&tree, reach_m);
+        history.push(filled);
+        if best.as_ref().is_none_or(|(f, _)| filled > *f) {
+            best = Some((filled, tree.clone()));
+        }
+        // Early on the seedling is still climbing the trunk's column: no stall before half.
+        let stalled = filled > 0.5
+            && history.len() > GAIN_WINDOW
+            && filled - history[history.len() - 1 - GAIN_WINDOW] < MIN_GAIN;
+        if filled >= FILLED || stalled {
+            break;
+        }
+    }
+    if let Some((best_filled, best_tree)) = best {
+        (filled, tree) = (best_filled, best_tree);
+        tree.update_widths();
+    }
+    let report = GrowthReport {
+        species: tree.species.name.clone(),
+        species_choice,
+        iterations: tree.iteration,
+        age_years: tree.age_years(),
+        hull_filled: filled,
+        attraction_points: num_points,
+    };
+    (tree, world_from_tree, report)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn crown_lifting_leaves_one_axis_below_the_crown_base() {
+        let species = Species::by_name("oak").expect("oak preset");
+        let mut tree = Tree::new(species, 3);
+        tree.grow_years(6.0);
+        let before = tree.skeleton.len();
+        let removed = lift_crown(&mut tree, 1.0);
+        assert!(removed > 0 && tree.skeleton.len() == before - removed);
+        let low: Vec<_> = tree
+            .skeleton
+            .internodes
+            .iter()
+            .filter(|n| n.end.y < 1.0)
+            .collect();
+        let branching = low
+            .iter()
+            .filter(|n| {
+                n.children()
+                    .filter(|c| tree.skeleton.get(*c).end.y < 1.0)
+                    .count()
+                    > 1
+            })
+            .count();
+        assert_eq!(branching, 0, "a branching point below the crown base");
+        assert!(tree.sanity_check().is_ok());
+    }
+}

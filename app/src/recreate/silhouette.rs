@@ -1,0 +1,166 @@
+//! The model's silhouette seen from a tracked frame: its finest meshes (branches and leaf cards)
+//! projected through the frame's camera (with the footage's distortion) and filled, for the
+//! agreement with a traced outline (intersection over union) and for comparing with true masks.
+
+use glam::{Affine3A, DVec2, Vec3};
+use sylva_core::Tree;
+use sylva_core::geometry::{Season, TreeMeshes};
+
+use super::footage::TrackedFootage;
+use super::hull::OutlineMask;
+
+/// The model's triangles in the world.
+pub struct WorldTriangles {
+    pub positions: Vec<Vec3>,
+    pub indices: Vec<u32>,
+}
+
+impl WorldTriangles {
+    /// The finest level's branches and leaf cards of `tree`, placed by `world_from_tree`.
+    pub fn of_tree(tree: &Tree, world_from_tree: &Affine3A) -> Self {
+        let meshes = sylva_core::geometry::build_tree_meshes_in(tree, Season::Summer);
+        Self::of_meshes(&meshes, world_from_tree)
+    }
+
+    pub fn of_meshes(meshes: &TreeMeshes, world_from_tree: &Affine3A) -> Self {
+        let mut out = WorldTriangles {
+            positions: Vec::new(),
+            indices: Vec::new(),
+        };
+        let parts = meshes
+            .lods
+            .first()
+            .map(|lod| &lod.branches)
+            .into_iter()
+            .chain([&meshes.leaves]);
+        for mesh in parts {
+            let base = out.positions.len() as u32;
+            out.positions.extend(
+                mesh.positions
+                    .iter()
+                    .map(|p| world_from_tree.transform_point3(Vec3::from(*p))),
+            );
+            out.indices.extend(mesh.indices.iter().map(|i| base + i));
+        }
+        out
+    }
+}
+
+/// A binary image, row-major.
+pub struct Silhouette {
+    pub width: u32,
+    pub height: u32,
+    pub inside: Vec<bool>,
+}
+
+impl Silhouette {
+    /// The model seen from `frame` (empty if the frame has no pose).
+    pub fn render(footage: &TrackedFootage, frame: usize, model: &WorldTriangles) -> Self {
+        let (width, height) = (footage.camera.width, footage.camera.height);
+        let mut inside = vec![false; (width * height) as usize];
+        if let Some(pose) = footage.world_from_camera.get(frame).copied().flatten() {
+            let camera_from_world = pose.inverse();
+            let projected: Vec<Option<DVec2>> = model
+                .positions
+                .iter()
+                .map(|p| {
+                    let c = camera_from_world.transform_point3(p.as_dvec3());
+                    (c.z > 1e-3)
+                        .then(|| footage.camera.pixel_from_camera(c))
+                        .flatten()
+                })
+                .collect();
+            for triangle in model.indices.chunks_exact(3) {
+                let corners = [0, 1, 2].map(|k| projected[triangle[k] as usize]);
+                if let [Some(a), Some(b), Some(c)] = corners {
+                    fill_triangle(&mut inside, width, height, a, b, c);
+                }
+            }
+        }
+        Self {
+            width,
+            height,
+            inside,
+        }
+    }
+
+    /// Intersection over union with an outline, inside the image.
+    pub fn iou_with_outline(&self, outline: &OutlineMask) -> f64 {
+        self.iou_with(|x, y| outline.contains(DVec2::new(x as f64, y as f64)))
+    }
+
+    /// Intersection over union with `other(x, y)`.
+    pub fn iou_with(&self, other: impl Fn(u32, u32) -> bool) -> f64 {
+        let (mut both, mut either) = (0usize, 0usize);
+        for y in 0..self.height {
+            for x in 0..self.width {
+                let a = self.inside[(y * self.width + x) as usize];
+                let b = other(x, y);
+                both += (a && b) as usize;
+                either += (a || b) as usize;
+            }
+        }
+        if either == 0 {
+            0.0
+        } else {
+            both as f64 / either as f64
+        }
+    }
+
+    /// 8-bit grey PNG: 255 on the model.
+    pub fn save_png(&self, path: &std::path::Path) -> anyhow::Result<()> {
+        let pixels: Vec<u8> = self
+            .inside
+            .iter()
+            .map(|&v| if v { 255 } else { 0 })
+            .collect();
+        image::save_buffer(path, &pixels, self.width, self.height, image::ColorType::L8)?;
+        Ok(())
+    }
+}
+
+/// Marks the pixels whose centres lie inside triangle `abc` (either winding).
+fn fill_triangle(inside: &mut [bool], width: u32, height: u32, a: DVec2, b: DVec2, c: DVec2) {
+    let area = (b - a).perp_dot(c - a);
+    if area.abs() < 1e-12 {
+        return;
+    }
+    let low = a.min(b).min(c);
+    let high = a.max(b).max(c);
+    let x0 = low.x.ceil().max(0.0) as i64;
+    let y0 = low.y.ceil().max(0.0) as i64;
+    let x1 = high.x.floor().min(width as f64 - 1.0) as i64;
+    let y1 = high.y.floor().min(height as f64 - 1.0) as i64;
+    let sign = area.signum();
+    for y in y0..=y1 {
+        for x in x0..=x1 {
+            let p = DVec2::new(x as f64, y as f64);
+            let w0 = (b - a).perp_dot(p - a) * sign;
+            let w1 = (c - b).perp_dot(p - b) * sign;
+            let w2 = (a - c).perp_dot(p - c) * sign;
+            if w0 >= 0.0 && w1 >= 0.0 && w2 >= 0.0 {
+                inside[(y as u32 * width + x as u32) as usize] = true;
+            }
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_filled_triangle_covers_half_its_bounding_square() {
+        let mut inside = vec![false; 100 * 100];
+        fill_triangle(
+            &mut inside,
+            100,
+            100,
+            DVec2::new(0.0, 0.0),
+            DVec2::new(99.0, 0.0),
+            DVec2::new(0.0, 99.0),
+        );
+        let count = inside.iter().filter(|&&v| v).count();
+        assert!((4900..5100).contains(&count), "{count} pixels");
+    }
+}

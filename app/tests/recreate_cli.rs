@@ -1,0 +1,510 @@
+//! `sylva recreate` on the project's synthetic tree footage (`test-data/tree_a`: a grammar tree on
+//! an open lawn; `test-data/tree_b`: another with a wall behind it). The marks are derived from
+//! the true silhouette masks the way a user draws them: a tap on the bottom of the trunk, and a
+//! rough polygon of 24 points around the crown, a little outside it. The measures are checked
+//! against `tree_truth.json`, the model's silhouettes against the true masks, and bad marks must
+//! be refused with an error naming the mark.
+
+use std::path::{Path, PathBuf};
+use std::process::{Command, Output};
+
+use serde_json::Value;
+
+fn data(name: &str) -> PathBuf {
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("../test-data")
+        .join(name)
+}
+
+fn sylva(args: &[&str]) -> Output {
+    Command::new(env!("CARGO_BIN_EXE_sylva"))
+        .args(args)
+        .output()
+        .expect("sylva runs")
+}
+
+fn text(output: &Output) -> String {
+    format!(
+        "{}{}",
+        String::from_utf8_lossy(&output.stdout),
+        String::from_utf8_lossy(&output.stderr)
+    )
+}
+
+/// A grey mask of frame `index` (255 foliage, 128 wood, 0 not the tree).
+struct Mask {
+    width: usize,
+    height: usize,
+    pixels: Vec<u8>,
+}
+
+fn mask(footage: &Path, index: usize) -> Mask {
+    let list = std::fs::read_to_string(footage.join("masks.txt")).expect("masks.txt");
+    let file = list
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .nth(index)
+        .and_then(|l| l.split_whitespace().nth(1))
+        .expect("a mask for the frame");
+    let image = image::open(footage.join(file))
+        .expect("mask png")
+        .to_luma8();
+    Mask {
+        width: image.width() as usize,
+        height: image.height() as usize,
+        pixels: image.into_raw(),
+    }
+}
+
+/// Small deterministic jitter in [0, 1).
+fn jitter(i: usize, salt: u64) -> f64 {
+    let mut z = (i as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ salt;
+    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
+    z ^= z >> 31;
+    (z >> 11) as f64 / (1u64 << 53) as f64
+}
+
+/// Convex hull (monotone chain) of integer points, counter-clockwise.
+fn convex_hull(mut points: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
+    points.sort_by(|a, b| a.partial_cmp(b).expect("finite"));
+    points.dedup();
+    let cross = |o: (f64, f64), a: (f64, f64), b: (f64, f64)| {
+        (a.0 - o.0) * (b.1 - o.1) - (a.1 - o.1) * (b.0 - o.0)
+    };
+    let mut hull: Vec<(f64, f64)> = Vec::new();
+    for pass in 0..2 {
+        let start = hull.len();
+        let iter: Box<dyn Iterator<Item = &(f64, f64)>> = if pass == 0 {
+            Box::new(points.iter())
+        } else {
+            Box::new(points.iter().rev())
+        };
+        for &p in iter {
+            while hull.len() >= start + 2
+                && cross(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0
+            {
+                hull.pop();
+            }
+            hull.push(p);
+        }
+        hull.pop();
+    }
+    hull
+}
+
+/// The crown as a user traces it: the foliage's outer boundary, walked at 24 evenly spaced
+/// points, each pushed 2–3.5 px outwards from the crown's centre.
+fn traced_outline(mask: &Mask, salt: u64) -> Vec<[f64; 2]> {
+    let mut corners = Vec::new();
+    for y in 0..mask.height {
+        for x in 0..mask.width {
+            if mask.pixels[y * mask.width + x] == 255 {
+                // The pixel's four corners, so the hull covers whole pixels.
+                for (dx, dy) in [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)] {
+                    corners.push((x as f64 + dx, y as f64 + dy));
+                }
+            }
+        }
+    }
+    assert!(!corners.is_empty(), "no foliage in the mask");
+    let hull = convex_hull(corners);
+    let n = hull.len();
+    let lengths: Vec<f64> = (0..n)
+        .map(|i| {
+            let (a, b) = (hull[i], hull[(i + 1) % n]);
+            ((b.0 - a.0).powi(2) + (b.1 - a.1).powi(2)).sqrt()
+        })
+        .collect();
+    let perimeter: f64 = lengths.iter().sum();
+    let centre = hull.iter().fold((0.0, 0.0), |c, p| (c.0 + p.0, c.1 + p.1));
+    let centre = (centre.0 / n as f64, centre.1 / n as f64);
+    const NUM_POINTS: usize = 24;
+    let mut outline = Vec::new();
+    let (mut edge, mut walked) = (0, 0.0);
+    for k in 0..NUM_POINTS {
+        let target = perimeter * k as f64 / NUM_POINTS as f64;
+        while walked + lengths[edge] < target {
+            walked += lengths[edge];
+            edge += 1;
+        }
+        let f = (target - walked) / lengths[edge].max(1e-9);
+        let (a, b) = (hull[edge], hull[(edge + 1) % n]);
+        let p = (a.0 + (b.0 - a.0) * f, a.1 + (b.1 - a.1) * f);
+        let (dx, dy) = (p.0 - centre.0, p.1 - centre.1);
+        let d = (dx * dx + dy * dy).sqrt().max(1e-9);
+        // A chord between two points on a convex boundary stays within a pixel of it at this
+        // spacing; the push covers that and is the user's "a little outside".
+        let push = 2.0 + 1.5 * jitter(k, salt);
+        outline.push([p.0 + dx / d * push, p.1 + dy / d * push]);
+    }
+    outline
+}
+
+/// The tap on the trunk base: the bottom of the wood below the crown, in its middle.
+fn base_tap(mask: &Mask) -> [f64; 2] {
+    for y in (0..mask.height).rev() {
+        let row: Vec<usize> = (0..mask.width)
+            .filter(|&x| mask.pixels[y * mask.width + x] == 128)
+            .collect();
+        if !row.is_empty() {
+            let middle = row.iter().sum::<usize>() as f64 / row.len() as f64;
+            return [middle, y as f64];
+        }
+    }
+    panic!("no trunk in the mask");
+}
+
+fn write_marks(dir: &Path, footage: &Path, base_frame: usize, crown_frames: &[usize]) -> PathBuf {
+    let base = base_tap(&mask(footage, base_frame));
+    let crown: Vec<Value> = crown_frames
+        .iter()
+        .map(|&f| serde_json::json!({"frame": f, "outline": traced_outline(&mask(footage, f), f as u64)}))
+        .collect();
+    let marks = serde_json::json!({"base": {"frame": base_frame, "pixel": base}, "crown": crown});
+    let path = dir.join("marks.json");
+    std::fs::write(&path, serde_json::to_string_pretty(&marks).expect("json"))
+        .expect("write marks");
+    path
+}
+
+struct Run {
+    line: String,
+    report: Value,
+    silhouettes: PathBuf,
+}
+
+fn recreate(dir: &Path, footage: &Path, marks: &Path, extra: &[&str]) -> Run {
+    let out = dir.join("tree.json");
+    let report = dir.join("report.json");
+    let glb = dir.join("tree.glb");
+    let silhouettes = dir.join("silhouettes");
+    let mut args = vec![
+        "recreate",
+        footage.to_str().expect("utf-8"),
+        "--marks",
+        marks.to_str().expect("utf-8"),
+        "--out",
+        out.to_str().expect("utf-8"),
+        "--glb",
+        glb.to_str().expect("utf-8"),
+        "--report",
+        report.to_str().expect("utf-8"),
+        "--silhouettes",
+        silhouettes.to_str().expect("utf-8"),
+    ];
+    args.extend_from_slice(extra);
+    let output = sylva(&args);
+    let all = text(&output);
+    assert!(output.status.success(), "sylva recreate failed:\n{all}");
+    let line = String::from_utf8_lossy(&output.stdout)
+        .lines()
+        .last()
+        .unwrap_or_default()
+        .to_owned();
+    assert!(out.exists() && glb.exists(), "tree and glb written");
+    let report: Value =
+        serde_json::from_str(&std::fs::read_to_string(&report).expect("report")).expect("json");
+    Run {
+        line,
+        report,
+        silhouettes,
+    }
+}
+
+fn field(line: &str, key: &str) -> f64 {
+    line.split_whitespace()
+        .find_map(|kv| kv.strip_prefix(&format!("{key}=")))
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("no {key}= in {line:?}"))
+}
+
+fn truth(footage: &Path) -> Value {
+    let text = std::fs::read_to_string(footage.join("tree_truth.json")).expect("truth");
+    serde_json::from_str::<Value>(&text).expect("json")["truth"].clone()
+}
+
+fn check_within(what: &str, measured: f64, truth: f64, tolerance: f64) {
+    let error = (measured - truth) / truth;
+    assert!(
+        error.abs() <= tolerance,
+        "{what}: measured {measured:.3} m, true {truth:.3} m ({:+.1}%, allowed ±{:.0}%)",
+        error * 100.0,
+        tolerance * 100.0
+    );
+}
+
+/// Mean IoU of the model's silhouettes and the true masks over `frames`.
+fn mean_iou(run: &Run, footage: &Path, frames: &[usize]) -> f64 {
+    let mut sum = 0.0;
+    for &f in frames {
+        let truth = mask(footage, f);
+        let model = image::open(run.silhouettes.join(format!("{f:05}.png")))
+            .unwrap_or_else(|e| panic!("silhouette of frame {f}: {e}"))
+            .to_luma8()
+            .into_raw();
+        let (mut both, mut either) = (0usize, 0usize);
+        for (t, m) in truth.pixels.iter().zip(&model) {
+            let (t, m) = (*t > 0, *m > 0);
+            both += (t && m) as usize;
+            either += (t || m) as usize;
+        }
+        sum += both as f64 / either.max(1) as f64;
+    }
+    sum / frames.len() as f64
+}
+
+fn check_measures(footage: &Path, run: &Run, height_tol: f64, full: bool) {
+    let truth = truth(footage);
+    let line = &run.line;
+    println!("{}: {line}", footage.display());
+    check_within(
+        "height",
+        field(line, "height_m"),
+        truth["height_m"].as_f64().expect("height"),
+        height_tol,
+    );
+    if full {
+        check_within(
+            "crown width",
+            field(line, "crown_width_m"),
+            truth["crown_width_m"].as_f64().expect("width"),
+            0.10,
+        );
+        check_within(
+            "crown base",
+            field(line, "crown_base_m"),
+            truth["crown_base_m"].as_f64().expect("base"),
+            0.15,
+        );
+    }
+    assert!(field(line, "internodes") > 50.0, "a grown model: {line}");
+    assert!(field(line, "tree_points") >= 0.0);
+    let frames = run.report["frames"].as_array().expect("frames");
+    assert!(
+        frames.len() > 150,
+        "{} tracked frames in the report",
+        frames.len()
+    );
+}
+
+#[test]
+fn tree_a_from_three_outlines_measures_height_width_and_crown_base_and_regrows_after_a_cut() {
+    let (_guard, dir) = work_dir("tree_a_three");
+    let footage = data("tree_a");
+    let marks = write_marks(&dir, &footage, 90, &[15, 90, 165]);
+    let run = recreate(&dir, &footage, &marks, &[]);
+    check_measures(&footage, &run, 0.05, true);
+    let marked = mean_iou(&run, &footage, &[15, 90, 165]);
+    let unmarked = mean_iou(&run, &footage, &[40, 60, 120, 140]);
+    println!(
+        "tree_a: IoU against the true masks: marked views {marked:.3}, unmarked {unmarked:.3}"
+    );
+    prune_a_main_limb_and_grow_ten_years(&dir.join("tree.json"));
+}
+
+/// The recreated tree is an ordinary tree: cut its largest main limb, grow 10 years, and the crown
+/// regrows into the gap (more internodes there than right after the cut), though less than the
+/// tree grown 10 years without the cut.
+fn prune_a_main_limb_and_grow_ten_years(tree_file: &Path) {
+    use sylva_core::Tree;
+    let tree = Tree::load(tree_file).expect("the recreated tree loads");
+    let nodes = &tree.skeleton.internodes;
+    // Main limbs: the lateral children of the trunk; the largest by internodes that is not the
+    // crown's top (at most a quarter of the tree).
+    let subtree_size = |root: sylva_core::NodeId| {
+        let flags = tree.skeleton.subtree_flags(&[root]);
+        flags.iter().filter(|&&f| f).count()
+    };
+    let limb = nodes
+        .iter()
+        .filter(|n| n.order == 0)
+        .flat_map(|n| n.lateral_children.iter().copied())
+        .filter(|&id| subtree_size(id) * 4 <= nodes.len())
+        .max_by_key(|&id| subtree_size(id))
+        .expect("the trunk has limbs");
+    let flags = tree.skeleton.subtree_flags(&[limb]);
+    let gap: Vec<glam::Vec3> = nodes
+        .iter()
+        .zip(&flags)
+        .filter(|(_, f)| **f)
+        .map(|(n, _)| n.end)
+        .collect();
+    assert!(gap.len() >= 10, "a main limb of {} internodes", gap.len());
+    let in_gap = |t: &Tree| {
+        t.skeleton
+            .internodes
+            .iter()
+            .filter(|n| gap.iter().any(|g| g.distance(n.end) < 0.25))
+            .count()
+    };
+    let mut cut = tree.clone();
+    let pick = nodes[limb.index()].end;
+    let pruned = sylva_core::edit::prune::prune_at(&mut cut, pick).expect("prune");
+    assert!(pruned.num_removed >= gap.len() / 2, "{pruned:?}");
+    let after_cut = in_gap(&cut);
+    let mut regrown = cut.clone();
+    regrown.grow_years(10.0);
+    let mut unpruned = tree.clone();
+    unpruned.grow_years(10.0);
+    let (regrown_n, unpruned_n) = (in_gap(&regrown), in_gap(&unpruned));
+    println!(
+        "prune: limb of {} internodes; in the gap: {after_cut} after the cut, {regrown_n} after 10 years, {unpruned_n} unpruned",
+        gap.len()
+    );
+    assert!(
+        regrown_n > after_cut,
+        "no regrowth into the gap: {regrown_n} internodes after 10 years, {after_cut} after the cut"
+    );
+    assert!(
+        regrown_n < unpruned_n,
+        "the cut tree has as much in the gap ({regrown_n}) as the unpruned one ({unpruned_n})"
+    );
+}
+
+#[test]
+fn tree_b_in_front_of_a_wall_from_two_outlines_measures_height_width_and_crown_base() {
+    let (_guard, dir) = work_dir("tree_b_two");
+    let footage = data("tree_b");
+    let marks = write_marks(&dir, &footage, 30, &[30, 150]);
+    let run = recreate(&dir, &footage, &marks, &[]);
+    check_measures(&footage, &run, 0.05, true);
+    let marked = mean_iou(&run, &footage, &[30, 150]);
+    let unmarked = mean_iou(&run, &footage, &[60, 90, 120]);
+    println!(
+        "tree_b: IoU against the true masks: marked views {marked:.3}, unmarked {unmarked:.3}"
+    );
+}
+
+#[test]
+fn tree_a_from_one_outline_measures_its_height_and_says_how_it_took_the_depth() {
+    let (_guard, dir) = work_dir("tree_a_one");
+    let footage = data("tree_a");
+    let marks = write_marks(&dir, &footage, 90, &[90]);
+    let run = recreate(&dir, &footage, &marks, &[]);
+    check_measures(&footage, &run, 0.08, false);
+    let depth = run.report["measurements"]["methods"]["crown_depth"]
+        .as_str()
+        .expect("a one-view note");
+    assert!(depth.starts_with("one outline"), "{depth}");
+}
+
+/// A temporary folder (the guard removes it), or `$SYLVA_RECREATE_KEEP/<name>` when that is
+/// set, kept to look at.
+fn work_dir(name: &str) -> (Option<tempfile::TempDir>, PathBuf) {
+    match std::env::var_os("SYLVA_RECREATE_KEEP") {
+        Some(keep) => {
+            let kept = PathBuf::from(keep).join(name);
+            std::fs::create_dir_all(&kept).expect("keep dir");
+            (None, kept)
+        }
+        None => {
+            let dir = tempfile::tempdir().expect("temp dir");
+            let path = dir.path().to_path_buf();
+            (Some(dir), path)
+        }
+    }
+}
+
+fn refused(dir: &Path, footage: &Path, marks: &Value, expected: &[&str]) {
+    let path = dir.join("bad.json");
+    std::fs::write(&path, marks.to_string()).expect("write");
+    let out = dir.join("t.json");
+    let output = sylva(&[
+        "recreate",
+        footage.to_str().expect("utf-8"),
+        "--marks",
+        path.to_str().expect("utf-8"),
+        "--out",
+        out.to_str().expect("utf-8"),
+    ]);
+    let all = text(&output);
+    assert!(!output.status.success(), "accepted {marks}:\n{all}");
+    assert!(!all.contains("panicked"), "panicked on {marks}:\n{all}");
+    for e in expected {
+        assert!(
+            all.contains(e),
+            "error for {marks} does not say {e:?}:\n{all}"
+        );
+    }
+    assert!(!out.exists(), "no tree written for bad marks");
+}
+
+fn square(frame: usize) -> Value {
+    serde_json::json!({"frame": frame, "outline": [[280.0, 60.0], [360.0, 60.0], [360.0, 200.0], [280.0, 200.0]]})
+}
+
+#[test]
+fn bad_marks_are_refused_with_errors_naming_the_mark() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    let footage = data("tree_a");
+    let base = serde_json::json!({"frame": 90, "pixel": [320.0, 330.0]});
+    refused(
+        dir.path(),
+        &footage,
+        &serde_json::json!({"base": base, "crown": [square(90), {"frame": 100, "outline": [[1.0, 2.0], [3.0, 4.0]]}]}),
+        &["crown[1]", "at least 3 points"],
+    );
+    refused(
+        dir.path(),
+        &footage,
+        &serde_json::json!({"base": base, "crown": [{"frame": 90, "outline": [[280.0, 60.0], [360.0, 200.0], [360.0, 60.0], [280.0, 200.0]]}]}),
+        &["crown[0]", "crosses itself"],
+    );
+    refused(
+        dir.path(),
+        &footage,
+        &serde_json::json!({"base": base, "crown": [square(90), square(180)]}),
+        &["crown[1]", "frame 180 is past the end", "180 frames"],
+    );
+    refused(
+        dir.path(),
+        &footage,
+        &serde_json::json!({"base": {"frame": 90}, "crown": [square(90)]}),
+        &["bad.json", "pixel"],
+    );
+}
+
+#[test]
+fn a_base_above_the_horizon_and_an_outline_in_a_lost_frame_are_refused_after_tracking() {
+    let dir = tempfile::tempdir().expect("temp dir");
+    // tree_a with a covered lens for frames 100–119: tracking is lost there.
+    let source = data("tree_a");
+    let footage = dir.path().join("tree_a_covered");
+    std::fs::create_dir_all(footage.join("rgb")).expect("mkdir");
+    for name in [
+        "rgb.txt",
+        "camera.txt",
+        "groundtruth.txt",
+        "accelerometer.txt",
+    ] {
+        std::fs::copy(source.join(name), footage.join(name)).expect("copy");
+    }
+    let list = std::fs::read_to_string(source.join("rgb.txt")).expect("rgb.txt");
+    let files: Vec<&str> = list
+        .lines()
+        .filter(|l| !l.starts_with('#'))
+        .filter_map(|l| l.split_whitespace().nth(1))
+        .collect();
+    for (i, file) in files.iter().enumerate() {
+        if (100..120).contains(&i) {
+            let dark = image::RgbImage::from_pixel(640, 480, image::Rgb([12, 12, 12]));
+            dark.save_with_format(footage.join(file), image::ImageFormat::Jpeg)
+                .expect("dark frame");
+        } else {
+            std::fs::copy(source.join(file), footage.join(file)).expect("copy frame");
+        }
+    }
+    let base = serde_json::json!({"frame": 90, "pixel": [320.0, 330.0]});
+    refused(
+        dir.path(),
+        &footage,
+        &serde_json::json!({"base": base, "crown": [square(90), square(110)]}),
+        &["crown[1]", "frame 110 was not tracked"],
+    );
+    refused(
+        dir.path(),
+        &footage,
+        &serde_json::json!({"base": {"frame": 90, "pixel": [320.0, 20.0]}, "crown": [square(90)]}),
+        &["base", "does not look at the ground"],
+    );
+}
