@@ -16,6 +16,7 @@ pub mod live;
 #[cfg(not(any(target_os = "android", target_os = "ios")))]
 pub mod live_capture;
 pub mod planting;
+pub mod platform;
 pub mod player;
 pub mod render;
 pub mod scale;
