@@ -202,8 +202,8 @@ impl ShellApp {
     }
 
     /// The app goes to the background (its window may be destroyed): fingers still down are
-    /// lifted, the tree is saved now, and frames are dropped until [`Self::resume`]. The
-    /// design stays in memory.
+    /// lifted, the tree and the session so far are saved now, and frames are dropped until
+    /// [`Self::resume`]. The design stays in memory.
     pub fn pause(&mut self) -> anyhow::Result<()> {
         for (id, pos) in std::mem::take(&mut self.touches_down) {
             self.events.push(egui::Event::Touch {
@@ -219,7 +219,13 @@ impl ShellApp {
         }
         self.paused = true;
         self.autosaver
-            .flush(&self.player.design, &self.player.session)
+            .flush(&self.player.design, &self.player.session)?;
+        // A phone may end a paused app without warning (and iOS's event loop never returns):
+        // the session so far is written too. Frames still being encoded complete in the
+        // background; a process killed before that leaves the last ones unreadable.
+        self.player
+            .session
+            .save(&StorageLocation::session_path(&self.session_dir))
     }
 
     /// The app is back in the foreground (draw into the new surface).

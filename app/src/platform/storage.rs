@@ -63,7 +63,7 @@ mod tests {
         );
         let blocked = StorageLocation::new(first.join("session.json/x"));
         std::fs::write(first.join("session.json"), "{}").expect("write");
-        let error = blocked.new_session_dir().err().expect("a file in the way");
+        let error = blocked.new_session_dir().expect_err("a file in the way");
         assert!(
             format!("{error}").contains("cannot create the app storage"),
             "{error}"

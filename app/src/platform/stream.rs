@@ -34,7 +34,7 @@ impl PlatformFeed {
 }
 
 enum FrameTracking {
-    Platform(PlatformTracker),
+    Platform(Box<PlatformTracker>),
     #[cfg(not(any(target_os = "android", target_os = "ios")))]
     Own(Box<crate::scene_tracking::FrameTracker>),
 }
@@ -70,7 +70,7 @@ impl PlatformStream {
         let camera = intrinsics.camera(frame_rate_hz);
         let tracking = match choice {
             TrackerChoice::Platform => {
-                FrameTracking::Platform(PlatformTracker::new(intrinsics_of(&camera)))
+                FrameTracking::Platform(Box::new(PlatformTracker::new(intrinsics_of(&camera))))
             }
             TrackerChoice::Own => own_tracker(camera, describe)?,
         };
@@ -236,13 +236,17 @@ mod tests {
         assert_eq!(shown.scene.world_from_camera, Some(pose));
         assert_eq!(shown.time_s, 0.5);
         feed.push(frame(8, None));
-        let error = stream.next(true).err().expect("refused");
+        let Err(error) = stream.next(true) else {
+            panic!("refused")
+        };
         assert!(
             format!("{error}").contains("test camera: frame 1 came without"),
             "{error}"
         );
         feed.push(frame(9, None));
-        let error = stream.next(true).err().expect("refused");
+        let Err(error) = stream.next(true) else {
+            panic!("refused")
+        };
         assert!(format!("{error}").contains("frame 2 is 9 x 6"), "{error}");
         drop(feed);
         assert!(matches!(stream.next(true), Ok(LiveNext::Ended)));

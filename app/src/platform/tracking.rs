@@ -124,7 +124,12 @@ fn is_horizontal_up(normal: Vec3) -> bool {
 }
 
 fn ground_of_plane(plane: &PlatformPlane) -> Option<GroundPlane> {
-    let normal = plane.normal_in_world.try_normalize()?;
+    // A unit normal is kept as the platform gave it (renormalising would change its last bits).
+    let n = plane.normal_in_world;
+    let normal = match n.length() {
+        length if (length - 1.0).abs() <= 1e-5 => n,
+        _ => n.try_normalize()?,
+    };
     (plane.center_in_world.is_finite() && is_horizontal_up(normal)).then_some(GroundPlane {
         point: plane.center_in_world,
         normal,
