@@ -354,14 +354,7 @@ mod desktop {
             let points = output.tracked_points.iter().map(|p| (p.id, p.world));
             let observations =
                 crate::platform::observations_of(world_from_camera, points, &self.intrinsics);
-            let occluder = self.mesher.update(&observations, world_from_camera, ground);
-            SceneFrame {
-                world_from_camera: Some(world_from_camera),
-                ground,
-                observations,
-                occluder,
-                tracking_ms: 0.0,
-            }
+            crate::platform::posed_scene(&mut self.mesher, world_from_camera, observations, ground)
         }
     }
 

@@ -46,6 +46,23 @@ pub fn observations_of(
         .collect()
 }
 
+/// The scene of a posed frame: its observations meshed into the occluder (both trackers).
+pub(crate) fn posed_scene(
+    mesher: &mut SceneMesher,
+    world_from_camera: Mat4,
+    observations: Vec<Observation>,
+    ground: Option<GroundPlane>,
+) -> SceneFrame {
+    let occluder = mesher.update(&observations, world_from_camera, ground);
+    SceneFrame {
+        world_from_camera: Some(world_from_camera),
+        ground,
+        observations,
+        occluder,
+        tracking_ms: 0.0,
+    }
+}
+
 /// Turns a platform tracker's frames into scenes: the occluder from the depth mesh of its
 /// feature points, the ground from the plane it chose.
 pub struct PlatformTracker {
@@ -83,14 +100,9 @@ impl PlatformTracker {
             .filter(|p| p.point_in_world.is_finite())
             .map(|p| (p.id, p.point_in_world));
         let observations = observations_of(world_from_camera, points, &self.intrinsics);
-        let occluder = self.mesher.update(&observations, world_from_camera, ground);
-        SceneFrame {
-            world_from_camera: Some(world_from_camera),
-            ground,
-            observations,
-            occluder,
-            tracking_ms: started.elapsed().as_secs_f32() * 1000.0,
-        }
+        let mut scene = posed_scene(&mut self.mesher, world_from_camera, observations, ground);
+        scene.tracking_ms = started.elapsed().as_secs_f32() * 1000.0;
+        scene
     }
 
     fn update_ground(&mut self, tracking: &PlatformTracking, pose: Option<Mat4>) {
