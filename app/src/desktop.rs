@@ -18,31 +18,22 @@ use winit::event_loop::{ActiveEventLoop, EventLoop};
 use winit::window::{Window, WindowId};
 
 use crate::frame_report::{FrameSample, FrameTimes};
+use crate::platform::{DrawSurface, ViewDrawer, WindowSurface};
 use crate::player::Player;
-use crate::render::resources::letterbox;
-use crate::render::{FrameView, Gpu, Renderer};
+use crate::render::Gpu;
 
 struct Gfx {
     window: Arc<Window>,
-    surface: wgpu::Surface<'static>,
-    config: wgpu::SurfaceConfiguration,
+    surface: WindowSurface,
     gpu: Gpu,
-    renderer: Renderer,
-    egui_ctx: egui::Context,
+    drawer: ViewDrawer,
     egui_state: egui_winit::State,
-    egui_renderer: egui_wgpu::Renderer,
 }
 
 struct DesktopApp {
     player: Player,
     gfx: Option<Gfx>,
     error: Option<anyhow::Error>,
-    meshed_revision: Option<u64>,
-    tree_mesher: crate::tree_model::TreeMesher,
-    /// The camera of the 3D view outside AR (framed on the tree when the view opens).
-    orbit: Option<crate::ui::orbit::OrbitCamera>,
-    /// Footage frame whose image and occluder the renderer holds.
-    uploaded_frame: Option<(usize, Option<glam::Affine3A>)>,
     started: Instant,
     session_path: PathBuf,
     autosaver: crate::autosave::Autosaver,
@@ -111,10 +102,6 @@ pub fn run_window(
         player,
         gfx: None,
         error: None,
-        meshed_revision: None,
-        tree_mesher: Default::default(),
-        orbit: None,
-        uploaded_frame: None,
         started: Instant::now(),
         session_path,
         autosaver,
@@ -159,41 +146,27 @@ fn create_gfx(event_loop: &ActiveEventLoop, size: (u32, u32)) -> anyhow::Result<
         .context("cannot create a drawing surface for the window")?;
     let gpu = Gpu::with_instance(instance, Some(&surface))?;
     let size = window.inner_size();
-    let mut config = surface
-        .get_default_config(&gpu.adapter, size.width.max(1), size.height.max(1))
-        .context("the window surface is not supported by the adapter")?;
-    let caps = surface.get_capabilities(&gpu.adapter);
-    if let Some(srgb) = caps.formats.iter().copied().find(|f| f.is_srgb()) {
-        config.format = srgb;
-    }
-    // Mailbox shows the newest frame without tearing and without the UI thread waiting for a
-    // vertical blank; FIFO where the surface offers nothing else.
-    config.present_mode = if caps.present_modes.contains(&wgpu::PresentMode::Mailbox) {
-        wgpu::PresentMode::Mailbox
-    } else {
-        wgpu::PresentMode::AutoVsync
-    };
-    surface.configure(&gpu.device, &config);
-    let renderer = Renderer::new(&gpu, config.format);
-    let egui_ctx = egui::Context::default();
+    let surface = WindowSurface::new(
+        &gpu,
+        surface,
+        (size.width, size.height),
+        window.scale_factor() as f32,
+    )?;
+    let drawer = ViewDrawer::new(&gpu, surface.format());
     let egui_state = egui_winit::State::new(
-        egui_ctx.clone(),
+        drawer.egui_ctx().clone(),
         egui::ViewportId::ROOT,
         &window,
         Some(window.scale_factor() as f32),
         None,
         Some(gpu.device.limits().max_texture_dimension_2d as usize),
     );
-    let egui_renderer = egui_wgpu::Renderer::new(&gpu.device, config.format, Default::default());
     Ok(Gfx {
         window,
         surface,
-        config,
         gpu,
-        renderer,
-        egui_ctx,
+        drawer,
         egui_state,
-        egui_renderer,
     })
 }
 
@@ -203,12 +176,7 @@ impl ApplicationHandler for DesktopApp {
             return;
         }
         match create_gfx(event_loop, self.window_size) {
-            Ok(gfx) => {
-                // A new renderer holds nothing yet.
-                self.gfx = Some(gfx);
-                self.uploaded_frame = None;
-                self.meshed_revision = None;
-            }
+            Ok(gfx) => self.gfx = Some(gfx),
             Err(e) => {
                 self.error = Some(e);
                 event_loop.exit();
@@ -224,19 +192,16 @@ impl ApplicationHandler for DesktopApp {
         match event {
             WindowEvent::CloseRequested => event_loop.exit(),
             WindowEvent::Resized(size) => {
-                gfx.config.width = size.width.max(1);
-                gfx.config.height = size.height.max(1);
-                gfx.surface.configure(&gfx.gpu.device, &gfx.config);
+                let scale = gfx.window.scale_factor() as f32;
+                gfx.surface
+                    .resize(&gfx.gpu, (size.width, size.height), scale);
             }
             WindowEvent::RedrawRequested => {
                 if let Err(e) = self.redraw() {
                     self.error = Some(e);
                     event_loop.exit();
                 }
-                let size = self
-                    .gfx
-                    .as_ref()
-                    .map_or((0, 0), |g| (g.config.width, g.config.height));
+                let size = self.gfx.as_ref().map_or((0, 0), |g| g.surface.size_px());
                 if let Some(times) = self.frame_times.as_ref().filter(|t| t.is_done()) {
                     if let Some(report) = times.report(size) {
                         print!("{report}");
@@ -323,168 +288,27 @@ impl DesktopApp {
         let Some(gfx) = self.gfx.as_mut() else {
             return Ok(());
         };
-        let frame = match gfx.surface.get_current_texture() {
-            wgpu::CurrentSurfaceTexture::Success(t)
-            | wgpu::CurrentSurfaceTexture::Suboptimal(t) => t,
-            wgpu::CurrentSurfaceTexture::Outdated | wgpu::CurrentSurfaceTexture::Lost => {
-                gfx.surface.configure(&gfx.gpu.device, &gfx.config);
-                return Ok(());
-            }
-            _ => return Ok(()),
+        let Some(target) = gfx.surface.begin_frame(&gfx.gpu)? else {
+            return Ok(());
         };
-        let target = frame.texture.create_view(&Default::default());
-        let size = (gfx.config.width, gfx.config.height);
-        let render_started = Instant::now();
-        let mut encoder = gfx.gpu.device.create_command_encoder(&Default::default());
-        if self.player.ui.orbit_view {
-            // Outside AR: the tree alone on a lawn, seen by the orbiting camera.
-            let tree = &self.player.design.tree;
-            if self.meshed_revision != Some(self.player.design.revision) {
-                let t = Instant::now();
-                gfx.renderer.set_tree(&gfx.gpu, self.tree_mesher.mesh(tree));
-                self.player.ui.budget.meshing_ms = t.elapsed().as_secs_f32() * 1000.0;
-                self.meshed_revision = Some(self.player.design.revision);
-            }
-            let drawn = self.tree_mesher.current();
-            let orbit = *self.orbit.get_or_insert_with(|| {
-                let (min, max) = drawn
-                    .bounds()
-                    .unwrap_or((glam::Vec3::ZERO, glam::Vec3::ONE));
-                crate::ui::orbit::OrbitCamera::framing(min, max)
-            });
-            let camera = orbit.camera(self.player.footage.intrinsics);
-            gfx.renderer.render(
-                &gfx.gpu,
-                &mut encoder,
-                &target,
-                size,
-                &FrameView::tree_only(camera),
-            );
-        } else if let Some(camera) = self.player.camera_in_tree() {
-            // The frame is drawn in tree space (the tree's mesh is), after planting.
-            let revision = Some(self.player.design.revision)
-                .filter(|_| self.player.ui.ground_found && self.player.design.is_planted());
-            if self.meshed_revision != revision {
-                let t = Instant::now();
-                match revision {
-                    Some(_) => gfx.renderer.set_tree(
-                        &gfx.gpu,
-                        self.tree_mesher
-                            .mesh_in(&self.player.design.tree, self.player.design.params.season),
-                    ),
-                    None => gfx.renderer.set_tree(&gfx.gpu, &Default::default()),
-                }
-                self.player.ui.budget.meshing_ms = t.elapsed().as_secs_f32() * 1000.0;
-                self.meshed_revision = revision;
-            }
-            // The footage image and the occluder change with the shown frame, not per redraw.
-            let placed = (self.player.frame, self.player.design.world_from_tree);
-            if self.uploaded_frame != Some(placed) {
-                if let Some(image) = &self.player.image {
-                    gfx.renderer.set_camera_image(
-                        &gfx.gpu,
-                        image.as_raw(),
-                        self.player.footage.intrinsics,
-                    );
-                }
-                if let Some(scene) = self.player.scene() {
-                    let occluder = crate::planting::occluder_in_tree(
-                        &scene.occluder,
-                        &self.player.design.tree_from_world(),
-                    );
-                    gfx.renderer.set_occluder(&gfx.gpu, &occluder);
-                }
-                self.uploaded_frame = Some(placed);
-            }
-            let mut view = FrameView::augmented(camera, self.player.ground_in_tree());
-            view.debug.depth_wireframe = self.player.ui.show_debug;
-            view.debug.brush = self.player.brush_sphere();
-            gfx.renderer
-                .render(&gfx.gpu, &mut encoder, &target, size, &view);
-        }
-        self.player.ui.budget.render_ms = render_started.elapsed().as_secs_f32() * 1000.0;
-        let ui_started = Instant::now();
-
         let raw = gfx.egui_state.take_egui_input(&gfx.window);
-        let intrinsics = self.player.footage.intrinsics;
-        let player = &mut self.player;
-        let orbit = &mut self.orbit;
-        let output = gfx.egui_ctx.run_ui(raw, |ui| {
-            let mut events = Vec::new();
-            let view = crate::ui::sylva_ui(ui, &mut player.ui, &player.design, &mut events);
-            match orbit.as_mut().filter(|_| player.ui.orbit_view) {
-                Some(orbit) => {
-                    let focal =
-                        letterbox(size, &intrinsics)[2] / intrinsics.width as f32 * intrinsics.fx;
-                    crate::ui::orbit::orbit_view_ui(ui, view, orbit, focal);
-                }
-                None => crate::ui::touch::view_touches_ui(ui, view, size, &intrinsics, &mut events),
-            }
-            for e in events {
-                player.input(e);
-            }
-        });
-        gfx.egui_state
-            .handle_platform_output(&gfx.window, output.platform_output);
-        let ppp = output.pixels_per_point;
-        let jobs = gfx.egui_ctx.tessellate(output.shapes, ppp);
-        let ui_ms = ui_started.elapsed().as_secs_f32() * 1000.0;
+        let size = gfx.surface.size_px();
+        let draw_started = Instant::now();
+        let output = gfx
+            .drawer
+            .draw(&gfx.gpu, &mut self.player, &target, size, raw);
+        let draw_ms = draw_started.elapsed().as_secs_f32() * 1000.0;
+        gfx.egui_state.handle_platform_output(&gfx.window, output);
         let present_started = Instant::now();
-        let screen = egui_wgpu::ScreenDescriptor {
-            size_in_pixels: [size.0, size.1],
-            pixels_per_point: ppp,
-        };
-        for (id, delta) in &output.textures_delta.set {
-            for d in delta {
-                gfx.egui_renderer
-                    .update_texture(&gfx.gpu.device, &gfx.gpu.queue, *id, d);
-            }
-        }
-        let callbacks = gfx.egui_renderer.update_buffers(
-            &gfx.gpu.device,
-            &gfx.gpu.queue,
-            &mut encoder,
-            &jobs,
-            &screen,
-        );
-        {
-            let load = if self.player.ui.orbit_view || self.player.camera().is_some() {
-                wgpu::LoadOp::Load
-            } else {
-                wgpu::LoadOp::Clear(wgpu::Color::BLACK)
-            };
-            let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
-                label: Some("egui"),
-                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                    view: &target,
-                    depth_slice: None,
-                    resolve_target: None,
-                    ops: wgpu::Operations {
-                        load,
-                        store: wgpu::StoreOp::Store,
-                    },
-                })],
-                depth_stencil_attachment: None,
-                timestamp_writes: None,
-                occlusion_query_set: None,
-                multiview_mask: None,
-            });
-            gfx.egui_renderer
-                .render(&mut pass.forget_lifetime(), &jobs, &screen);
-        }
-        for id in &output.textures_delta.free {
-            gfx.egui_renderer.free_texture(id);
-        }
-        gfx.gpu
-            .queue
-            .submit(callbacks.into_iter().chain([encoder.finish()]));
-        gfx.gpu.queue.present(frame);
+        gfx.surface.end_frame(&gfx.gpu)?;
         if let Some(times) = self.frame_times.as_mut() {
+            let render_ms = self.player.ui.budget.render_ms;
             let sample = FrameSample {
                 frame_ms,
                 update_ms,
-                render_ms: self.player.ui.budget.render_ms,
-                ui_ms,
+                render_ms,
+                // The drawer runs the UI and submits after encoding the view.
+                ui_ms: (draw_ms - render_ms).max(0.0),
                 present_ms: present_started.elapsed().as_secs_f32() * 1000.0,
                 seeking,
             };

@@ -18,6 +18,7 @@ pub mod live;
 #[cfg(not(any(target_os = "android", target_os = "ios")))]
 pub mod live_capture;
 pub mod planting;
+pub mod platform;
 pub mod player;
 pub mod recreate;
 pub mod render;

@@ -292,7 +292,7 @@ fn pinhole_of(intrinsics: &Intrinsics) -> PinholeIntrinsics {
 mod desktop {
     use super::*;
     use anyhow::Context;
-    use glam::{DMat4, DVec3, Vec2, Vec3};
+    use glam::{DMat4, DVec3, Vec3};
     use sylva_tracking::sequence::FileListSource;
     use sylva_tracking::{
         Camera, Frame, FrameSource, SourceEvent, Tracker, TrackerConfig, TumSequence,
@@ -350,36 +350,11 @@ mod desktop {
                 };
             };
             let world_from_camera = DMat4::from(world_from_camera).as_mat4();
-            let camera_from_world = world_from_camera.inverse();
-            let k = &self.intrinsics;
-            // Observations at the ideal (undistorted) pixel of each tracked point, with its
-            // depth along the optical axis: what the pinhole depth mesh expects.
-            let observations: Vec<Observation> = output
-                .tracked_points
-                .iter()
-                .filter_map(|p| {
-                    let c = camera_from_world.transform_point3(p.world);
-                    // Rounded to 0.01 px and 1 mm (far below tracking noise) so sessions
-                    // record them compactly and replays mesh exactly what the app meshed.
-                    let round = |x: f32, step: f32| (x / step).round() * step;
-                    (c.z > 1e-3 && c.is_finite()).then(|| Observation {
-                        id: p.id,
-                        pixel: Vec2::new(
-                            round(k.fx * c.x / c.z + k.cx, 0.01),
-                            round(k.fy * c.y / c.z + k.cy, 0.01),
-                        ),
-                        depth_m: round(c.z, 0.001),
-                    })
-                })
-                .collect();
-            let occluder = self.mesher.update(&observations, world_from_camera, ground);
-            SceneFrame {
-                world_from_camera: Some(world_from_camera),
-                ground,
-                observations,
-                occluder,
-                tracking_ms: 0.0,
-            }
+            // The same observations a platform tracker's feature points make.
+            let points = output.tracked_points.iter().map(|p| (p.id, p.world));
+            let observations =
+                crate::platform::observations_of(world_from_camera, points, &self.intrinsics);
+            crate::platform::posed_scene(&mut self.mesher, world_from_camera, observations, ground)
         }
     }
 

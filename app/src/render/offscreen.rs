@@ -72,6 +72,18 @@ impl Offscreen {
             (self.width, self.height),
             view,
         );
+        gpu.queue.submit([encoder.finish()]);
+        self.read(gpu)
+    }
+
+    /// The texture frames are drawn into.
+    pub fn view(&self) -> &wgpu::TextureView {
+        &self.view
+    }
+
+    /// Reads the texture back as an image (the last frame drawn into it).
+    pub fn read(&self, gpu: &Gpu) -> anyhow::Result<RgbaImage> {
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
         encoder.copy_texture_to_buffer(
             wgpu::TexelCopyTextureInfo {
                 texture: &self.texture,

@@ -1,0 +1,199 @@
+//! Drawing one frame of the app into a surface texture: the AR view (camera image, occluder,
+//! tree) or the 3D view outside AR, then the UI on top. Every shell draws through this, the
+//! desktop window as much as the phones and the host tests.
+
+use std::time::Instant;
+
+use crate::player::Player;
+use crate::render::resources::letterbox;
+use crate::render::{FrameView, Gpu, Renderer};
+
+/// The renderer, the UI's context and renderer, and what they hold of the design.
+pub struct ViewDrawer {
+    renderer: Renderer,
+    egui_ctx: egui::Context,
+    egui_renderer: egui_wgpu::Renderer,
+    tree_mesher: crate::tree_model::TreeMesher,
+    meshed_revision: Option<u64>,
+    /// The camera of the 3D view outside AR (framed on the tree when the view opens).
+    orbit: Option<crate::ui::orbit::OrbitCamera>,
+    /// Footage frame whose image and occluder the renderer holds.
+    uploaded_frame: Option<(usize, Option<glam::Affine3A>)>,
+}
+
+impl ViewDrawer {
+    /// A drawer for surfaces of `format`.
+    pub fn new(gpu: &Gpu, format: wgpu::TextureFormat) -> ViewDrawer {
+        ViewDrawer {
+            renderer: Renderer::new(gpu, format),
+            egui_ctx: egui::Context::default(),
+            egui_renderer: egui_wgpu::Renderer::new(&gpu.device, format, Default::default()),
+            tree_mesher: Default::default(),
+            meshed_revision: None,
+            orbit: None,
+            uploaded_frame: None,
+        }
+    }
+
+    /// The UI's context (for a shell's input translation).
+    pub fn egui_ctx(&self) -> &egui::Context {
+        &self.egui_ctx
+    }
+
+    /// The surface format this drawer renders for.
+    pub fn format(&self) -> wgpu::TextureFormat {
+        self.renderer.color_format()
+    }
+
+    /// Draws the shown frame and the UI (fed `raw` input; its events go to the player) into
+    /// `target` of `size` pixels and submits the work; returns the UI's platform output.
+    pub fn draw(
+        &mut self,
+        gpu: &Gpu,
+        player: &mut Player,
+        target: &wgpu::TextureView,
+        size: (u32, u32),
+        raw: egui::RawInput,
+    ) -> egui::PlatformOutput {
+        let render_started = Instant::now();
+        let mut encoder = gpu.device.create_command_encoder(&Default::default());
+        self.draw_view(gpu, player, &mut encoder, target, size);
+        player.ui.budget.render_ms = render_started.elapsed().as_secs_f32() * 1000.0;
+
+        let intrinsics = player.footage.intrinsics;
+        let orbit = &mut self.orbit;
+        let output = self.egui_ctx.run_ui(raw, |ui| {
+            let mut events = Vec::new();
+            let view = crate::ui::sylva_ui(ui, &mut player.ui, &player.design, &mut events);
+            match orbit.as_mut().filter(|_| player.ui.orbit_view) {
+                Some(orbit) => {
+                    let focal =
+                        letterbox(size, &intrinsics)[2] / intrinsics.width as f32 * intrinsics.fx;
+                    crate::ui::orbit::orbit_view_ui(ui, view, orbit, focal);
+                }
+                None => crate::ui::touch::view_touches_ui(ui, view, size, &intrinsics, &mut events),
+            }
+            for e in events {
+                player.input(e);
+            }
+        });
+        let ppp = output.pixels_per_point;
+        let jobs = self.egui_ctx.tessellate(output.shapes, ppp);
+        let screen = egui_wgpu::ScreenDescriptor {
+            size_in_pixels: [size.0, size.1],
+            pixels_per_point: ppp,
+        };
+        for (id, delta) in &output.textures_delta.set {
+            for d in delta {
+                self.egui_renderer
+                    .update_texture(&gpu.device, &gpu.queue, *id, d);
+            }
+        }
+        let callbacks = self.egui_renderer.update_buffers(
+            &gpu.device,
+            &gpu.queue,
+            &mut encoder,
+            &jobs,
+            &screen,
+        );
+        {
+            let load = if player.ui.orbit_view || player.camera().is_some() {
+                wgpu::LoadOp::Load
+            } else {
+                wgpu::LoadOp::Clear(wgpu::Color::BLACK)
+            };
+            let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+                label: Some("egui"),
+                color_attachments: &[Some(wgpu::RenderPassColorAttachment {
+                    view: target,
+                    depth_slice: None,
+                    resolve_target: None,
+                    ops: wgpu::Operations {
+                        load,
+                        store: wgpu::StoreOp::Store,
+                    },
+                })],
+                depth_stencil_attachment: None,
+                timestamp_writes: None,
+                occlusion_query_set: None,
+                multiview_mask: None,
+            });
+            self.egui_renderer
+                .render(&mut pass.forget_lifetime(), &jobs, &screen);
+        }
+        for id in &output.textures_delta.free {
+            self.egui_renderer.free_texture(id);
+        }
+        gpu.queue
+            .submit(callbacks.into_iter().chain([encoder.finish()]));
+        output.platform_output
+    }
+
+    /// The 3D part of the frame: the AR view after planting, or the tree alone outside AR.
+    fn draw_view(
+        &mut self,
+        gpu: &Gpu,
+        player: &mut Player,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &wgpu::TextureView,
+        size: (u32, u32),
+    ) {
+        if player.ui.orbit_view {
+            // Outside AR: the tree alone on a lawn, seen by the orbiting camera.
+            let tree = &player.design.tree;
+            if self.meshed_revision != Some(player.design.revision) {
+                let t = Instant::now();
+                self.renderer.set_tree(gpu, self.tree_mesher.mesh(tree));
+                player.ui.budget.meshing_ms = t.elapsed().as_secs_f32() * 1000.0;
+                self.meshed_revision = Some(player.design.revision);
+            }
+            let drawn = self.tree_mesher.current();
+            let orbit = *self.orbit.get_or_insert_with(|| {
+                let (min, max) = drawn
+                    .bounds()
+                    .unwrap_or((glam::Vec3::ZERO, glam::Vec3::ONE));
+                crate::ui::orbit::OrbitCamera::framing(min, max)
+            });
+            let camera = orbit.camera(player.footage.intrinsics);
+            self.renderer
+                .render(gpu, encoder, target, size, &FrameView::tree_only(camera));
+        } else if let Some(camera) = player.camera_in_tree() {
+            // The frame is drawn in tree space (the tree's mesh is), after planting.
+            let revision = Some(player.design.revision)
+                .filter(|_| player.ui.ground_found && player.design.is_planted());
+            if self.meshed_revision != revision {
+                let t = Instant::now();
+                match revision {
+                    Some(_) => self.renderer.set_tree(
+                        gpu,
+                        self.tree_mesher
+                            .mesh_in(&player.design.tree, player.design.params.season),
+                    ),
+                    None => self.renderer.set_tree(gpu, &Default::default()),
+                }
+                player.ui.budget.meshing_ms = t.elapsed().as_secs_f32() * 1000.0;
+                self.meshed_revision = revision;
+            }
+            // The footage image and the occluder change with the shown frame, not per redraw.
+            let placed = (player.frame, player.design.world_from_tree);
+            if self.uploaded_frame != Some(placed) {
+                if let Some(image) = &player.image {
+                    self.renderer
+                        .set_camera_image(gpu, image.as_raw(), player.footage.intrinsics);
+                }
+                if let Some(scene) = player.scene() {
+                    let occluder = crate::planting::occluder_in_tree(
+                        &scene.occluder,
+                        &player.design.tree_from_world(),
+                    );
+                    self.renderer.set_occluder(gpu, &occluder);
+                }
+                self.uploaded_frame = Some(placed);
+            }
+            let mut view = FrameView::augmented(camera, player.ground_in_tree());
+            view.debug.depth_wireframe = player.ui.show_debug;
+            view.debug.brush = player.brush_sphere();
+            self.renderer.render(gpu, encoder, target, size, &view);
+        }
+    }
+}
