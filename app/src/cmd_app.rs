@@ -14,9 +14,13 @@ pub const DEMO_SEQUENCE: &str = "test-data/demo_garden";
 pub struct ReplayArgs {
     /// Session file (JSON) to replay.
     pub session: PathBuf,
-    /// Folder for composited PNG frames and the final tree.
+    /// Folder for composited PNG frames and the final tree (empty, or new).
     #[arg(long)]
     pub out: PathBuf,
+    /// Replay into a folder that is not empty, removing the frames, tree and placement an
+    /// earlier replay wrote there (other files are left).
+    #[arg(long)]
+    pub force: bool,
 }
 
 #[derive(clap::Args, Debug)]
@@ -84,7 +88,8 @@ pub fn demo() -> anyhow::Result<()> {
     let out = PathBuf::from("out/demo");
     let footage = Footage::open(&sequence)?;
     let session = crate::demo_script::demo_session(&footage, sequence.clone())?;
-    std::fs::create_dir_all(&out).with_context(|| format!("cannot create {}", out.display()))?;
+    // The demo's own folder: an earlier demo's frames are removed, not left beside the new ones.
+    crate::outputs::prepare_replay_folder(&out, true)?;
     let session_path = out.join("demo-session.json");
     let mut absolute = session.clone();
     absolute.footage = std::fs::canonicalize(&sequence).unwrap_or(sequence);
@@ -237,6 +242,9 @@ fn open_stream(input: StreamSource, _args: &ViewArgs) -> anyhow::Result<()> {
 
 /// `sylva replay SESSION --out DIR`.
 pub fn replay_command(args: ReplayArgs) -> anyhow::Result<()> {
+    let outputs = ["tree.json", "tree.glb", "placement.json"].map(|name| args.out.join(name));
+    crate::outputs::check_outputs(&[&args.session], &outputs.each_ref().map(PathBuf::as_path))?;
+    crate::outputs::prepare_replay_folder(&args.out, args.force)?;
     let report = replay(&args.session, Some(&args.out), true, |_, _| {})?;
     println!("{}", report.summary_line());
     Ok(())

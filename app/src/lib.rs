@@ -15,6 +15,7 @@ pub mod footage;
 pub mod live;
 #[cfg(not(any(target_os = "android", target_os = "ios")))]
 pub mod live_capture;
+pub mod outputs;
 pub mod planting;
 pub mod player;
 pub mod render;

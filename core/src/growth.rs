@@ -21,7 +21,6 @@ mod space;
 mod vigor;
 mod widths;
 
-pub(crate) use io::write_atomically;
 pub use io::{TREE_FORMAT_VERSION, TreeFileError};
 pub use widths::solve_pipe_exponent;
 

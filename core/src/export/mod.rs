@@ -17,7 +17,7 @@ mod obj;
 use std::path::{Path, PathBuf};
 
 pub use glb::{glb_bytes, write_glb};
-pub use obj::write_obj;
+pub use obj::{obj_files, write_obj};
 
 /// Side length of the generated bark and leaf textures, pixels.
 pub const TEXTURE_SIZE: u32 = 256;
