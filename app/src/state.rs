@@ -317,7 +317,8 @@ fn move_to_iteration(
     scene: Option<(&dyn Scene, SceneMode)>,
 ) -> Result<(), sylva_core::edit::EditError> {
     if target < tree.iteration {
-        return timeline.go_to(tree, target);
+        // A thinned-out iteration lands on the latest kept one before it.
+        return timeline.go_to(tree, timeline.kept_at_or_before(target).unwrap_or(target));
     }
     while tree.iteration < target {
         tree.grow(1, scene);
@@ -338,6 +339,11 @@ fn planted(species: Species, seed: u64) -> Tree {
 
 /// Undo steps kept.
 const MAX_UNDO: usize = 64;
+/// Memory of the undo steps and of the timeline, each in multiples of the tree's saved state
+/// (the oldest dropped, or thinned, beyond it): with the tree itself the design stays within
+/// about three times the tree's size however long it is edited (see `examples/soak.rs`).
+const UNDO_BUDGET_TREES: f32 = 1.0;
+const TIMELINE_BUDGET_TREES: f32 = 1.0;
 
 impl DesignState {
     /// A sapling of `params.species` (the default species for an unknown name) planted at the
@@ -356,13 +362,13 @@ impl DesignState {
         let mut species = species_named(&params.species);
         params.apply_to(&mut species);
         let tree = planted(species, seed);
-        let mut timeline = Timeline::default();
+        let mut timeline = Timeline::with_budget(TIMELINE_BUDGET_TREES);
         timeline.keep(&tree);
         DesignState {
             params,
             tree,
             seed,
-            history: History::new(MAX_UNDO),
+            history: History::new(MAX_UNDO).with_budget(UNDO_BUDGET_TREES),
             timeline,
             stroke: None,
             brush: None,
@@ -485,7 +491,7 @@ impl DesignState {
                 ..Parameters::for_species(&species)
             };
             self.tree = planted(species, self.seed);
-            self.timeline = Timeline::default();
+            self.timeline = Timeline::with_budget(TIMELINE_BUDGET_TREES);
             self.timeline.keep(&self.tree);
             self.brush = None;
             self.changed();

@@ -17,6 +17,7 @@ mod buds;
 mod io;
 mod light;
 mod shoots;
+mod snapshot;
 mod space;
 mod vigor;
 mod widths;
