@@ -51,6 +51,10 @@ pub struct ViewArgs {
     /// in the session) instead of waiting for the user's tap.
     #[arg(long)]
     pub plant_at_origin: bool,
+    /// Restore the earlier autosaved design (`out/last-session.1.tree.json`, kept when the window
+    /// starts) instead of starting from a sapling; the window also offers it with a button.
+    #[arg(long)]
+    pub restore: bool,
 }
 
 /// Finds the demo sequence from the current folder or the workspace the binary was built in.
@@ -112,6 +116,7 @@ struct WindowStart {
     paused: bool,
     orbit: bool,
     plant_at_origin: bool,
+    restore: bool,
 }
 
 fn open_window(sequence: &Path, start: WindowStart) -> anyhow::Result<()> {
@@ -121,7 +126,14 @@ fn open_window(sequence: &Path, start: WindowStart) -> anyhow::Result<()> {
     let footage_ref = std::fs::canonicalize(sequence).unwrap_or_else(|_| sequence.to_owned());
     let mut player = crate::player::Player::new(footage, footage_ref)?;
     player.plant_at_origin = start.plant_at_origin;
-    crate::desktop::run_window(player, session_path, start.frame, start.paused, start.orbit)
+    crate::desktop::run_window(
+        player,
+        session_path,
+        start.frame,
+        start.paused,
+        start.orbit,
+        start.restore,
+    )
 }
 
 /// What `sylva view` plays.
@@ -187,6 +199,7 @@ pub fn view(args: ViewArgs) -> anyhow::Result<()> {
             paused: args.paused,
             orbit: args.orbit,
             plant_at_origin: args.plant_at_origin,
+            restore: args.restore,
         },
     )
 }
@@ -228,7 +241,14 @@ fn open_stream(input: StreamSource, args: &ViewArgs) -> anyhow::Result<()> {
     if let Some(dir) = args.record.as_ref() {
         eprintln!("recording the frames shown into {}", dir.display());
     }
-    crate::desktop::run_window(player, session_path, 0, args.paused, args.orbit)
+    crate::desktop::run_window(
+        player,
+        session_path,
+        0,
+        args.paused,
+        args.orbit,
+        args.restore,
+    )
 }
 
 #[cfg(any(target_os = "android", target_os = "ios"))]

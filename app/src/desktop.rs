@@ -39,6 +39,8 @@ struct DesktopApp {
     started: Instant,
     session_path: PathBuf,
     autosaver: crate::autosave::Autosaver,
+    /// The earlier autosave the window offers back (until restored or dismissed).
+    restore_offer: Option<crate::autosave::PreviousAutosave>,
 }
 
 /// Opens a window on `player` (recorded footage or a stream); returns an error when no window
@@ -49,17 +51,36 @@ pub fn run_window(
     first_frame: usize,
     paused: bool,
     orbit_view: bool,
+    restore: bool,
 ) -> anyhow::Result<()> {
     let event_loop = EventLoop::new().context("cannot connect to a display")?;
     event_loop.set_control_flow(winit::event_loop::ControlFlow::Poll);
     player.frame = first_frame.min(player.footage.len().saturating_sub(1));
     player.ui.orbit_view = orbit_view;
     player.ui.playing = !paused;
-    let autosaver = crate::autosave::Autosaver::new(
+    let mut autosaver = crate::autosave::Autosaver::new(
         &session_path,
         !player.is_live(),
         crate::autosave::AUTOSAVE_INTERVAL,
     );
+    let mut restore_offer = autosaver.keep_previous(&player.design)?;
+    if let Some(previous) = &restore_offer {
+        println!(
+            "the earlier design is kept in {}",
+            previous.tree_path.display()
+        );
+    }
+    if restore {
+        let previous = restore_offer.take().with_context(|| {
+            format!(
+                "--restore: no earlier autosave beside {}",
+                session_path.display()
+            )
+        })?;
+        player.input(crate::autosave::restore_event(&previous.tree_path)?);
+        println!("restored {}", previous.tree_path.display());
+    }
+    crate::autosave::exit_on_signals();
     println!("autosaving the tree to {}", autosaver.tree_path().display());
     let mut app = DesktopApp {
         player,
@@ -72,6 +93,7 @@ pub fn run_window(
         started: Instant::now(),
         session_path,
         autosaver,
+        restore_offer,
     };
     event_loop
         .run_app(&mut app)
@@ -182,7 +204,11 @@ impl ApplicationHandler for DesktopApp {
         }
     }
 
-    fn about_to_wait(&mut self, _event_loop: &ActiveEventLoop) {
+    fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
+        if crate::autosave::exit_requested() {
+            event_loop.exit(); // a signal closes as the close button does: flushed below
+            return;
+        }
         if let Err(error) =
             self.autosaver
                 .poll(Instant::now(), &self.player.design, &self.player.session)
@@ -287,9 +313,11 @@ impl DesktopApp {
         let intrinsics = self.player.footage.intrinsics;
         let player = &mut self.player;
         let orbit = &mut self.orbit;
+        let restore_offer = &mut self.restore_offer;
         let output = gfx.egui_ctx.run_ui(raw, |ui| {
             let mut events = Vec::new();
             let view = crate::ui::sylva_ui(ui, &mut player.ui, &player.design, &mut events);
+            crate::autosave::restore_prompt_ui(ui, restore_offer, &mut events);
             match orbit.as_mut().filter(|_| player.ui.orbit_view) {
                 Some(orbit) => {
                     let focal =

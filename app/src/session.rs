@@ -193,6 +193,16 @@ impl Session {
         for (i, timed) in self.events.iter().enumerate() {
             let why = match &timed.event {
                 InputEvent::Parameters { parameters } => parameters.check().err(),
+                InputEvent::RestoreTree {
+                    tree_file,
+                    world_from_tree,
+                } => crate::autosave::parse_restored_tree(tree_file)
+                    .err()
+                    .or_else(|| {
+                        world_from_tree
+                            .is_some_and(|m| !m.iter().all(|v| v.is_finite()))
+                            .then(|| "a restored tree placed at a non-finite pose".into())
+                    }),
                 InputEvent::Grow { iterations }
                     if iterations.unsigned_abs() > crate::state::MAX_ITERATIONS_PER_REQUEST =>
                 {

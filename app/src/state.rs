@@ -232,6 +232,11 @@ pub enum InputEvent {
     ScaleTool {
         tool: Option<ScaleTool>,
     },
+    /// Restores an autosaved design (undoable): the tree file's JSON and where it stood.
+    RestoreTree {
+        tree_file: String,
+        world_from_tree: Option<[f32; 12]>,
+    },
 }
 
 /// A brush stroke.
@@ -470,7 +475,38 @@ impl DesignState {
                 self.scale.set_holding_height_m(*holding_height_m)
             }
             InputEvent::ScaleTool { tool } => self.scale.choose(*tool),
+            InputEvent::RestoreTree {
+                tree_file,
+                world_from_tree,
+            } => {
+                if let Ok(tree) = crate::autosave::parse_restored_tree(tree_file) {
+                    self.restore_tree(tree, *world_from_tree);
+                }
+            }
         }
+    }
+
+    /// Replaces the design's tree by a restored one (undoable), standing where it stood.
+    fn restore_tree(&mut self, tree: Tree, world_from_tree: Option<[f32; 12]>) {
+        self.history.record(OperationKind::Parameters, &self.tree);
+        self.params = Parameters {
+            brush_radius: self.params.brush_radius,
+            grow_speed: self.params.grow_speed,
+            scene_mode: self.params.scene_mode,
+            season: self.params.season,
+            years: tree.age_years(),
+            ..Parameters::for_species(&tree.species)
+        };
+        self.tree = tree;
+        self.timeline = Timeline::with_budget(TIMELINE_BUDGET_TREES);
+        self.timeline.keep(&self.tree);
+        if let Some(m) = world_from_tree {
+            self.world_from_tree = Some(Affine3A::from_cols_array(&m));
+        }
+        self.brush = None;
+        self.bend = None;
+        self.selected = None;
+        self.changed();
     }
 
     /// New parameters (undoable). Another species starts a seedling of it.

@@ -72,6 +72,7 @@ fn view_args(video: &Path) -> ViewArgs {
         paused: false,
         orbit: false,
         plant_at_origin: false,
+        restore: false,
     }
 }
 

@@ -12,7 +12,7 @@
 //! Set `SYLVA_SCREENSHOT_DIR` to keep the screenshots.
 
 use std::path::{Path, PathBuf};
-use std::process::{Child, Command, Stdio};
+use std::process::{Command, Stdio};
 use std::time::Duration;
 
 use glam::{DAffine3, Vec2, Vec3};
@@ -24,44 +24,14 @@ use sylva_app::scene_tracking::SceneTracker;
 use sylva_tracking::linalg::Similarity;
 use sylva_tracking::metrics::{PosePair, align_frames};
 
+mod xvfb;
+
+use xvfb::{Killed, start_xvfb};
+
 const WINDOW: (u32, u32) = (1120, 720);
-
-struct Killed(Child);
-
-impl Drop for Killed {
-    fn drop(&mut self) {
-        let _ = self.0.kill();
-        let _ = self.0.wait();
-    }
-}
 
 fn demo() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("../test-data/demo_garden")
-}
-
-fn start_xvfb() -> (Killed, String) {
-    let display = format!(":{}", 90 + std::process::id() % 100);
-    let child = Command::new("Xvfb")
-        .args([
-            display.as_str(),
-            "-screen",
-            "0",
-            "1280x800x24",
-            "-nolisten",
-            "tcp",
-        ])
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .expect("Xvfb is required for this test (apt-get install xvfb)");
-    let socket = format!("/tmp/.X11-unix/X{}", &display[1..]);
-    for _ in 0..100 {
-        if Path::new(&socket).exists() {
-            break;
-        }
-        std::thread::sleep(Duration::from_millis(100));
-    }
-    (Killed(child), display)
 }
 
 /// Runs the app paused at `frame` and takes a screenshot once the window shows that frame of the
