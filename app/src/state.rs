@@ -344,11 +344,13 @@ fn planted(species: Species, seed: u64) -> Tree {
 
 /// Undo steps kept.
 const MAX_UNDO: usize = 64;
-/// Memory of the undo steps and of the timeline, each in multiples of the tree's saved state
-/// (the oldest dropped, or thinned, beyond it): with the tree itself the design stays within
+/// Memory of the undo steps and of the timeline, each in multiples of the tree's own size
+/// (`Tree::own_bytes`; the oldest dropped, or thinned, beyond it): with the tree itself the design stays within
 /// about three times the tree's size however long it is edited (see `examples/soak.rs`).
-const UNDO_BUDGET_TREES: f32 = 1.0;
-const TIMELINE_BUDGET_TREES: f32 = 1.0;
+const UNDO_BUDGET_TREES: f32 = 0.75;
+/// Finished strokes kept (oldest dropped).
+const MAX_FINISHED_STROKES: usize = 16;
+const TIMELINE_BUDGET_TREES: f32 = 0.75;
 
 impl DesignState {
     /// A sapling of `params.species` (the default species for an unknown name) planted at the
@@ -393,6 +395,11 @@ impl DesignState {
             revision: 0,
             grow_debt: 0.0,
         }
+    }
+
+    /// Bytes held by the undo snapshots and by the timeline's kept states (the soak report).
+    pub fn snapshot_bytes(&self) -> (usize, usize) {
+        (self.history.snapshot_bytes(), self.timeline.kept_bytes())
     }
 
     /// Number of undo steps available.
@@ -796,6 +803,12 @@ impl DesignState {
             && !stroke.points.is_empty()
         {
             self.finished_strokes.push(stroke);
+            // The latest strokes only: memory must not grow with the length of a session.
+            let excess = self
+                .finished_strokes
+                .len()
+                .saturating_sub(MAX_FINISHED_STROKES);
+            self.finished_strokes.drain(..excess);
         }
     }
 

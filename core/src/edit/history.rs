@@ -65,7 +65,7 @@ pub struct History {
     /// Oldest snapshots are dropped beyond this many (0 = unlimited).
     pub max_operations: usize,
     /// Oldest snapshots are dropped while all of them (undo and redo) hold more than this many
-    /// times the current tree's saved state (0 = unlimited); the last undo step and the next
+    /// times the current tree's own size ([`Tree::own_bytes`]; 0 = unlimited); the last undo step and the next
     /// redo step always stay.
     pub budget_trees: f32,
 }
@@ -78,8 +78,8 @@ impl History {
         }
     }
 
-    /// Keeps the snapshots within `budget_trees` times the current tree's saved state
-    /// ([`Tree::saved_state_bytes`]), so memory stays a fixed multiple of the tree's size.
+    /// Keeps the snapshots within `budget_trees` times the current tree's own size
+    /// ([`Tree::own_bytes`]), so memory stays a fixed multiple of the tree's size.
     pub fn with_budget(self, budget_trees: f32) -> History {
         History {
             budget_trees,
@@ -90,7 +90,7 @@ impl History {
     /// Call before performing an operation on `tree`: remembers the state to return to and
     /// forgets the redo branch.
     pub fn record(&mut self, kind: OperationKind, tree: &Tree) {
-        self.push(kind, tree.compact_clone(), tree.saved_state_bytes());
+        self.push(kind, tree.compact_clone(), tree.own_bytes());
     }
 
     fn push(&mut self, kind: OperationKind, before: Tree, current_bytes: usize) {
@@ -128,7 +128,7 @@ impl History {
         let before = tree.compact_clone();
         match operation(tree) {
             Ok(value) => {
-                self.push(kind, before, tree.saved_state_bytes());
+                self.push(kind, before, tree.own_bytes());
                 Ok(value)
             }
             Err(e) => {
@@ -145,7 +145,7 @@ impl History {
         let kind = snapshot.kind;
         let current = std::mem::replace(tree, snapshot.restored());
         self.redo.push(Snapshot::of(kind, current));
-        self.fit_budget(tree.saved_state_bytes());
+        self.fit_budget(tree.own_bytes());
         Some(kind)
     }
 
@@ -155,7 +155,7 @@ impl History {
         let kind = snapshot.kind;
         let current = std::mem::replace(tree, snapshot.restored());
         self.undo.push(Snapshot::of(kind, current));
-        self.fit_budget(tree.saved_state_bytes());
+        self.fit_budget(tree.own_bytes());
         Some(kind)
     }
 
@@ -185,19 +185,21 @@ struct Kept {
 ///
 /// Unbounded by default, every iteration is kept. With a budget ([`Timeline::with_budget`])
 /// the states are thinned as the tree grows so that together they hold at most that many times
-/// the latest state: the first and the latest always stay, and older iterations are kept
+/// the latest tree's own size ([`Tree::own_bytes`]): the first and the latest always stay, and older iterations are kept
 /// farther apart than recent ones (gaps grow with age), so a thousand iterations ungrow to
 /// any recent one and to a coarse ladder of older ones.
 #[derive(Clone, Debug, Default)]
 pub struct Timeline {
     /// Kept states in increasing iteration.
     states: Vec<Kept>,
-    /// Thinning budget, in multiples of the latest state's bytes (0 = keep every iteration).
+    /// Thinning budget, in multiples of the latest tree's own size (0 = keep every iteration).
     pub budget_trees: f32,
+    /// [`Tree::own_bytes`] of the latest tree kept.
+    latest_own_bytes: usize,
 }
 
 impl Timeline {
-    /// A timeline whose states hold at most `budget_trees` times the latest state's bytes.
+    /// A timeline whose states hold at most `budget_trees` times the latest tree's own size.
     pub fn with_budget(budget_trees: f32) -> Timeline {
         Timeline {
             budget_trees,
@@ -218,6 +220,7 @@ impl Timeline {
         }
         self.states.retain(|s| s.iteration < k);
         let compact = tree.compact_clone();
+        self.latest_own_bytes = tree.own_bytes();
         self.states.push(Kept {
             iteration: k,
             bytes: compact.saved_state_bytes(),
@@ -235,7 +238,7 @@ impl Timeline {
         if self.budget_trees <= 0.0 {
             return;
         }
-        let budget = (f64::from(self.budget_trees) * latest.bytes as f64) as usize;
+        let budget = (f64::from(self.budget_trees) * self.latest_own_bytes as f64) as usize;
         let latest_iteration = latest.iteration;
         let mut total: usize = self.states.iter().map(|s| s.bytes).sum();
         while total > budget && self.states.len() > 2 {
@@ -336,7 +339,7 @@ mod tests {
     #[test]
     fn a_budgeted_timeline_stays_within_its_multiple_of_the_tree_and_ungrows_exactly() {
         let mut tree = sapling(3);
-        let mut timeline = Timeline::with_budget(1.5);
+        let mut timeline = Timeline::with_budget(0.5);
         timeline.keep(&tree);
         let mut saved = std::collections::BTreeMap::new();
         for _ in 0..40 {
@@ -344,11 +347,11 @@ mod tests {
             timeline.keep(&tree);
             saved.insert(tree.iteration, tree.to_json_bytes().expect("json"));
             assert!(
-                timeline.kept_bytes() as f64 <= 1.5 * tree.saved_state_bytes() as f64 + 1.0
+                timeline.kept_bytes() as f64 <= 0.5 * tree.own_bytes() as f64 + 1.0
                     || timeline.num_kept() <= 2,
                 "{} bytes kept for a {}-byte tree",
                 timeline.kept_bytes(),
-                tree.saved_state_bytes()
+                tree.own_bytes()
             );
         }
         assert_eq!(timeline.range(), Some((0, 40)), "first and latest stay");
@@ -377,7 +380,7 @@ mod tests {
     #[test]
     fn a_budgeted_history_keeps_the_last_step_and_drops_the_oldest_beyond_its_budget() {
         let mut tree = sapling(4);
-        let mut history = History::new(64).with_budget(1.0);
+        let mut history = History::new(64).with_budget(0.25);
         for _ in 0..12 {
             history
                 .perform(OperationKind::Grow, &mut tree, |t| {
@@ -387,11 +390,11 @@ mod tests {
                 .expect("grows");
             assert!(history.num_undoable() >= 1);
             assert!(
-                history.num_undoable() == 1 || history.snapshot_bytes() <= tree.saved_state_bytes(),
+                history.num_undoable() == 1 || history.snapshot_bytes() <= tree.own_bytes() / 4,
                 "{} undo steps hold {} bytes for a {}-byte tree",
                 history.num_undoable(),
                 history.snapshot_bytes(),
-                tree.saved_state_bytes()
+                tree.own_bytes()
             );
         }
         assert!(history.num_undoable() < 12, "the oldest were dropped");

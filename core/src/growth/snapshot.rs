@@ -45,6 +45,15 @@ impl Tree {
         self.update_widths();
     }
 
+    /// Bytes of the whole tree: its saved state plus the shadow grid and pipe exponents derived
+    /// from it (the working memory of an iteration aside). The budgets of the undo history and
+    /// the timeline are multiples of it.
+    pub fn own_bytes(&self) -> usize {
+        self.saved_state_bytes()
+            + self.environment.shadow.num_voxels() * size_of::<i32>()
+            + self.pipe_exponents.capacity() * size_of::<f32>()
+    }
+
     /// Heap and inline bytes of the tree's saved state: what a [`Tree::compact_clone`] holds.
     pub fn saved_state_bytes(&self) -> usize {
         let internodes = &self.skeleton.internodes;
