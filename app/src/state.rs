@@ -322,12 +322,20 @@ fn move_to_iteration(
     scene: Option<(&dyn Scene, SceneMode)>,
 ) -> Result<(), sylva_core::edit::EditError> {
     if target < tree.iteration {
-        // A thinned-out iteration lands on the latest kept one before it.
-        return timeline.go_to(tree, timeline.kept_at_or_before(target).unwrap_or(target));
+        // A thinned-out iteration: the latest kept one before it, regrown to it when only
+        // autonomous growth happened in between (else the ungrow lands there).
+        let kept = timeline.kept_at_or_before(target).unwrap_or(target);
+        timeline.go_to(tree, kept)?;
+        if timeline.regrows_autonomously(kept, target) {
+            while tree.iteration < target {
+                tree.grow(1, scene);
+            }
+        }
+        return Ok(());
     }
     while tree.iteration < target {
         tree.grow(1, scene);
-        timeline.keep(tree);
+        timeline.keep_autonomous(tree);
     }
     Ok(())
 }

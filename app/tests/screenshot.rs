@@ -43,6 +43,10 @@ fn screenshot(
     image: &RgbaImage,
     k: &Intrinsics,
 ) -> RgbaImage {
+    // Each run in a folder of its own: the second would otherwise find the first one's autosave
+    // and offer it back over the footage.
+    let run_dir = dir.join(format!("run-{frame}"));
+    std::fs::create_dir_all(&run_dir).expect("run folder");
     let app = Command::new(env!("CARGO_BIN_EXE_sylva"))
         .arg("view")
         .arg(demo())
@@ -52,7 +56,7 @@ fn screenshot(
             "--paused",
             "--plant-at-origin",
         ])
-        .current_dir(dir)
+        .current_dir(&run_dir)
         .env("DISPLAY", display)
         .env_remove("WAYLAND_DISPLAY")
         .stdout(Stdio::null())

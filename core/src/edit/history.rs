@@ -179,6 +179,9 @@ struct Kept {
     iteration: u32,
     tree: Tree,
     bytes: usize,
+    /// Every iteration since the previous kept state was autonomous growth (so it regrows
+    /// from that state exactly, given the same scene).
+    autonomous: bool,
 }
 
 /// Growth states by iteration, for ungrow/regrow.
@@ -210,6 +213,17 @@ impl Timeline {
     /// Remembers `tree` as the state at its current iteration, dropping any later states
     /// (they belong to a future that an edit has just replaced).
     pub fn keep(&mut self, tree: &Tree) {
+        self.keep_step(tree, false);
+    }
+
+    /// [`Timeline::keep`] for a state reached by one autonomous iteration from the previous
+    /// one: a thinned-out iteration between such states regrows exactly
+    /// ([`Timeline::regrows_autonomously`]).
+    pub fn keep_autonomous(&mut self, tree: &Tree) {
+        self.keep_step(tree, true);
+    }
+
+    fn keep_step(&mut self, tree: &Tree, autonomous: bool) {
         let k = tree.iteration;
         let contiguous = match (self.states.first(), self.states.last()) {
             (Some(first), Some(last)) => first.iteration <= k && k <= last.iteration + 1,
@@ -225,6 +239,7 @@ impl Timeline {
             iteration: k,
             bytes: compact.saved_state_bytes(),
             tree: compact,
+            autonomous,
         });
         self.thin();
     }
@@ -250,8 +265,21 @@ impl Timeline {
             let victim = (1..self.states.len() - 1)
                 .min_by(|&a, &b| cost(a).total_cmp(&cost(b)))
                 .unwrap_or(1);
-            total -= self.states.remove(victim).bytes;
+            let removed = self.states.remove(victim);
+            self.states[victim].autonomous &= removed.autonomous;
+            total -= removed.bytes;
         }
+    }
+
+    /// Whether every iteration from the kept `from` up to `to` was autonomous growth, so that
+    /// growing the state at `from` autonomously reaches the state `to` had.
+    pub fn regrows_autonomously(&self, from: u32, to: u32) -> bool {
+        self.is_kept(from)
+            && self
+                .states
+                .iter()
+                .find(|s| s.iteration > from)
+                .is_some_and(|next| next.iteration >= to && next.autonomous)
     }
 
     fn find(&self, iteration: u32) -> Option<&Kept> {
@@ -375,6 +403,30 @@ mod tests {
         assert!(timeline.go_to(&mut tree.clone(), missing).is_err());
         let landed = timeline.kept_at_or_before(missing).expect("an earlier one");
         assert!(landed < missing && timeline.is_kept(landed));
+        assert!(
+            !timeline.regrows_autonomously(landed, missing),
+            "kept by keep()"
+        );
+    }
+
+    #[test]
+    fn a_thinned_autonomous_iteration_regrows_exactly_from_the_state_before_it() {
+        let mut tree = sapling(5);
+        let mut timeline = Timeline::with_budget(0.5);
+        timeline.keep(&tree);
+        let mut saved = std::collections::BTreeMap::new();
+        for _ in 0..30 {
+            tree.grow(1, None);
+            timeline.keep_autonomous(&tree);
+            saved.insert(tree.iteration, tree.to_json_bytes().expect("json"));
+        }
+        let missing = (1..30).find(|&k| !timeline.is_kept(k)).expect("thinned");
+        let from = timeline.kept_at_or_before(missing).expect("earlier");
+        assert!(timeline.regrows_autonomously(from, missing));
+        let mut back = tree.clone();
+        timeline.go_to(&mut back, from).expect("kept");
+        back.grow(missing - from, None);
+        assert!(back.to_json_bytes().expect("json") == saved[&missing]);
     }
 
     #[test]
