@@ -14,9 +14,13 @@ pub const DEMO_SEQUENCE: &str = "test-data/demo_garden";
 pub struct ReplayArgs {
     /// Session file (JSON) to replay.
     pub session: PathBuf,
-    /// Folder for composited PNG frames and the final tree.
+    /// Folder for composited PNG frames and the final tree (empty, or new).
     #[arg(long)]
     pub out: PathBuf,
+    /// Replay into a folder that is not empty, removing the frames, tree and placement an
+    /// earlier replay wrote there (other files are left).
+    #[arg(long)]
+    pub force: bool,
 }
 
 #[derive(clap::Args, Debug)]
@@ -47,6 +51,10 @@ pub struct ViewArgs {
     /// in the session) instead of waiting for the user's tap.
     #[arg(long)]
     pub plant_at_origin: bool,
+    /// Restore the earlier autosaved design (`out/last-session.1.tree.json`, kept when the window
+    /// starts) instead of starting from a sapling; the window also offers it with a button.
+    #[arg(long)]
+    pub restore: bool,
     /// Measure this many redraws while the footage plays and the tracker runs, print the
     /// frame-time report (median and 95th percentile, ms per frame) and close the window.
     #[arg(long, value_name = "N")]
@@ -104,7 +112,8 @@ pub fn demo() -> anyhow::Result<()> {
     let out = PathBuf::from("out/demo");
     let footage = Footage::open(&sequence)?;
     let session = crate::demo_script::demo_session(&footage, sequence.clone())?;
-    std::fs::create_dir_all(&out).with_context(|| format!("cannot create {}", out.display()))?;
+    // The demo's own folder: an earlier demo's frames are removed, not left beside the new ones.
+    crate::outputs::prepare_replay_folder(&out, true)?;
     let session_path = out.join("demo-session.json");
     let mut absolute = session.clone();
     absolute.footage = std::fs::canonicalize(&sequence).unwrap_or(sequence);
@@ -157,6 +166,7 @@ impl ViewArgs {
             orbit_view: self.orbit,
             size: self.window_size,
             frame_report: self.frame_report,
+            restore: self.restore,
         }
     }
 
@@ -268,6 +278,9 @@ fn open_stream(input: StreamSource, _args: &ViewArgs) -> anyhow::Result<()> {
 
 /// `sylva replay SESSION --out DIR`.
 pub fn replay_command(args: ReplayArgs) -> anyhow::Result<()> {
+    let outputs = ["tree.json", "tree.glb", "placement.json"].map(|name| args.out.join(name));
+    crate::outputs::check_outputs(&[&args.session], &outputs.each_ref().map(PathBuf::as_path))?;
+    crate::outputs::prepare_replay_folder(&args.out, args.force)?;
     let report = replay(&args.session, Some(&args.out), true, |_, _| {})?;
     println!("{}", report.summary_line());
     Ok(())

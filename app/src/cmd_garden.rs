@@ -131,6 +131,14 @@ pub fn garden(args: GardenArgs) -> anyhow::Result<()> {
             args.years
         );
     }
+    let inputs: Vec<&std::path::Path> = args
+        .planting
+        .iter()
+        .map(PathBuf::as_path)
+        .chain(args.species.iter().map(std::path::Path::new))
+        .filter(|p| p.is_file())
+        .collect();
+    crate::outputs::check_outputs(&inputs, &[&args.out])?;
     let (file, origin) = planting(&args)?;
     let resolve = |name: &str| load_species(name).map_err(|e| format!("{e:#}"));
     let trees = file

@@ -8,7 +8,7 @@ use sylva_core::Tree;
 use sylva_core::geometry::Season;
 use sylva_core::species::Species;
 
-use crate::state::MAX_DESIGN_YEARS;
+use crate::state::{MAX_DESIGN_YEARS, MAX_ITERATIONS_PER_REQUEST};
 
 /// Arguments of `sylva grow`.
 #[derive(clap::Args, Debug)]
@@ -79,7 +79,17 @@ pub fn grow(args: GrowArgs) -> anyhow::Result<()> {
             args.years
         );
     }
+    check_grow_files(&args)?;
     let species = load_species(&args.species)?;
+    let iterations = species.iterations_for_years(args.years);
+    if iterations > MAX_ITERATIONS_PER_REQUEST {
+        anyhow::bail!(
+            "--years {} of {} is {iterations} growth iterations ({} years each); at most {MAX_ITERATIONS_PER_REQUEST} are grown at once",
+            args.years,
+            args.species,
+            species.years_per_iteration
+        );
+    }
     let started = Instant::now();
     let mut tree = Tree::new(species, args.seed);
     tree.grow_years(args.years);
@@ -92,6 +102,29 @@ pub fn grow(args: GrowArgs) -> anyhow::Result<()> {
         m.num_internodes, m.height_m, m.crown_width_m, m.trunk_diameter_m, elapsed_ms
     );
     Ok(())
+}
+
+/// Refuses, before growing, outputs that are the species file or each other (`--out t.json
+/// --glb t.json`), and outputs that are not regular writable files.
+fn check_grow_files(args: &GrowArgs) -> anyhow::Result<()> {
+    let species_file = Species::by_name(&args.species)
+        .is_err()
+        .then(|| PathBuf::from(&args.species));
+    let mut outputs = vec![args.out.clone()];
+    outputs.extend(args.glb.clone());
+    outputs.extend(
+        args.obj
+            .iter()
+            .flat_map(|p| sylva_core::export::obj_files(p)),
+    );
+    let outputs: Vec<&Path> = outputs.iter().map(PathBuf::as_path).collect();
+    crate::outputs::check_outputs(
+        &species_file
+            .iter()
+            .map(PathBuf::as_path)
+            .collect::<Vec<_>>(),
+        &outputs,
+    )
 }
 
 /// Writes the `--glb` and `--obj` files of the tree in `season`, if asked for, one line each

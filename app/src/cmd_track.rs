@@ -63,12 +63,35 @@ pub fn track(_args: TrackArgs) -> anyhow::Result<()> {
     anyhow::bail!("`sylva track` needs the OpenCV tracker, which phone builds leave out")
 }
 
+/// Refuses, before tracking, a `--report` or `--plot` that is one of the sequence's list files
+/// or the other output.
+#[cfg(not(any(target_os = "android", target_os = "ios")))]
+fn check_track_files(args: &TrackArgs) -> anyhow::Result<()> {
+    let lists = [
+        "rgb.txt",
+        "depth.txt",
+        "groundtruth.txt",
+        "camera.txt",
+        "accelerometer.txt",
+    ]
+    .map(|name| args.sequence.join(name));
+    let inputs: Vec<&std::path::Path> = lists.iter().map(PathBuf::as_path).collect();
+    let outputs: Vec<&std::path::Path> = args
+        .report
+        .iter()
+        .chain(&args.plot)
+        .map(PathBuf::as_path)
+        .collect();
+    crate::outputs::check_outputs(&inputs, &outputs)
+}
+
 #[cfg(not(any(target_os = "android", target_os = "ios")))]
 pub fn track(args: TrackArgs) -> anyhow::Result<()> {
     use indicatif::{ProgressBar, ProgressStyle};
     use sylva_tracking::report::run_sequence_scaled;
     use sylva_tracking::run_scale::ScaleOptions;
 
+    check_track_files(&args)?;
     let config = sylva_tracking::TrackerConfig {
         holding_height_m: args.holding_height_m,
         rolling_shutter_readout_s: args.readout_ms.map(|ms| ms / 1000.0),
@@ -127,7 +150,7 @@ pub fn track(args: TrackArgs) -> anyhow::Result<()> {
     }
     if let Some(path) = &args.report {
         let json = serde_json::to_string_pretty(&report).context("encoding the report")?;
-        std::fs::write(path, json).with_context(|| format!("writing {}", path.display()))?;
+        crate::outputs::write_file(path, json.as_bytes())?;
     }
     if report.tracked_frames == 0 {
         println!("{}", report.summary_line());

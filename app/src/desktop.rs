@@ -44,6 +44,8 @@ struct DesktopApp {
     frame_times: Option<FrameTimes>,
     /// Inner size the window opens at, logical pixels.
     window_size: (u32, u32),
+    /// The earlier autosave the window offers back (until restored or dismissed).
+    restore_offer: Option<crate::autosave::PreviousAutosave>,
 }
 
 /// How long a redraw may spend catching up a seek before it draws (the window shows the
@@ -63,6 +65,8 @@ pub struct WindowOptions {
     pub size: (u32, u32),
     /// Measure this many redraws, print the frame-time report and close.
     pub frame_report: Option<usize>,
+    /// Restore the earlier autosave (kept when the window starts) at once.
+    pub restore: bool,
 }
 
 impl Default for WindowOptions {
@@ -73,6 +77,7 @@ impl Default for WindowOptions {
             orbit_view: false,
             size: (1120, 720),
             frame_report: None,
+            restore: false,
         }
     }
 }
@@ -92,11 +97,29 @@ pub fn run_window(
     player.ui.orbit_view = options.orbit_view;
     player.ui.playing = !options.paused;
     let live = player.is_live();
-    let autosaver = crate::autosave::Autosaver::new(
+    let mut autosaver = crate::autosave::Autosaver::new(
         &session_path,
         !player.is_live(),
         crate::autosave::AUTOSAVE_INTERVAL,
     );
+    let mut restore_offer = autosaver.keep_previous(&player.design)?;
+    if let Some(previous) = &restore_offer {
+        println!(
+            "the earlier design is kept in {}",
+            previous.tree_path.display()
+        );
+    }
+    if options.restore {
+        let previous = restore_offer.take().with_context(|| {
+            format!(
+                "--restore: no earlier autosave beside {}",
+                session_path.display()
+            )
+        })?;
+        player.input(crate::autosave::restore_event(&previous.tree_path)?);
+        println!("restored {}", previous.tree_path.display());
+    }
+    crate::autosave::exit_on_signals();
     println!("autosaving the tree to {}", autosaver.tree_path().display());
     let mut app = DesktopApp {
         player,
@@ -109,6 +132,7 @@ pub fn run_window(
         tracked_until: None,
         frame_times: options.frame_report.map(FrameTimes::new),
         window_size: options.size,
+        restore_offer,
     };
     event_loop
         .run_app(&mut app)
@@ -213,7 +237,11 @@ impl ApplicationHandler for DesktopApp {
         }
     }
 
-    fn about_to_wait(&mut self, _event_loop: &ActiveEventLoop) {
+    fn about_to_wait(&mut self, event_loop: &ActiveEventLoop) {
+        if crate::autosave::exit_requested() {
+            event_loop.exit(); // a signal closes as the close button does: flushed below
+            return;
+        }
         if let Err(error) =
             self.autosaver
                 .poll(Instant::now(), &self.player.design, &self.player.session)
@@ -294,9 +322,15 @@ impl DesktopApp {
         let raw = gfx.egui_state.take_egui_input(&gfx.window);
         let size = gfx.surface.size_px();
         let draw_started = Instant::now();
-        let output = gfx
-            .drawer
-            .draw(&gfx.gpu, &mut self.player, &target, size, raw);
+        let restore_offer = &mut self.restore_offer;
+        let output = gfx.drawer.draw_with(
+            &gfx.gpu,
+            &mut self.player,
+            &target,
+            size,
+            raw,
+            |ui, events| crate::autosave::restore_prompt_ui(ui, restore_offer, events),
+        );
         let draw_ms = draw_started.elapsed().as_secs_f32() * 1000.0;
         gfx.egui_state.handle_platform_output(&gfx.window, output);
         let present_started = Instant::now();

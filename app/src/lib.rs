@@ -17,6 +17,7 @@ pub mod frame_report;
 pub mod live;
 #[cfg(not(any(target_os = "android", target_os = "ios")))]
 pub mod live_capture;
+pub mod outputs;
 pub mod planting;
 pub mod platform;
 pub mod player;

@@ -127,10 +127,18 @@ impl FootageRecorder {
     pub fn create(root: &Path, camera: &Camera) -> anyhow::Result<FootageRecorder> {
         let rgb_list = root.join("rgb.txt");
         // A folder left by a start that failed before its first frame (no window) is reused.
-        let lists_frames = std::fs::read_to_string(&rgb_list).is_ok_and(|text| {
-            text.lines()
-                .any(|l| !l.trim().is_empty() && !l.trim_start().starts_with('#'))
-        });
+        // Read bounded, and only a regular file: a FIFO or a device there is refused.
+        let listed = sylva_tracking::input_file::read_regular_file(
+            &rgb_list,
+            sylva_tracking::input_file::MAX_LIST_FILE_BYTES,
+        );
+        let lists_frames = match listed {
+            Ok(bytes) => String::from_utf8_lossy(&bytes)
+                .lines()
+                .any(|l| !l.trim().is_empty() && !l.trim_start().starts_with('#')),
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => false,
+            Err(e) => bail!("cannot record into {}: {e}", root.display()),
+        };
         if lists_frames {
             bail!(
                 "{} already holds a recording ({} exists); choose another folder",
@@ -142,8 +150,9 @@ impl FootageRecorder {
         std::fs::create_dir_all(&rgb)
             .with_context(|| format!("cannot create {}", rgb.display()))?;
         let camera_path = root.join("camera.txt");
-        std::fs::write(&camera_path, camera_file_text(camera))
-            .with_context(|| format!("cannot write {}", camera_path.display()))?;
+        crate::outputs::write_file(&camera_path, camera_file_text(camera).as_bytes())?;
+        // rgb.txt is a log appended frame by frame (each line once its frame is on disk).
+        sylva_core::safe_write::check_output(&rgb_list)?;
         let mut list = std::fs::File::create(&rgb_list)
             .with_context(|| format!("cannot create {}", rgb_list.display()))?;
         writeln!(list, "# timestamp filename (sylva view --record)")
@@ -157,14 +166,15 @@ impl FootageRecorder {
             .spawn(move || -> anyhow::Result<()> {
                 for (time_s, relative, rgba) in receiver {
                     let path = root_owned.join(&relative);
-                    image::DynamicImage::ImageRgba8(rgba)
-                        .to_rgb8()
-                        .save(&path)
-                        .with_context(|| format!("cannot write {}", path.display()))?;
+                    crate::outputs::write_png(
+                        &image::DynamicImage::ImageRgba8(rgba).to_rgb8(),
+                        &path,
+                    )?;
                     writeln!(list, "{time_s:.6} {}", relative.display())
                         .with_context(|| format!("cannot write {}", rgb_list.display()))?;
                 }
                 list.flush()
+                    .and_then(|()| list.sync_all())
                     .with_context(|| format!("cannot write {}", rgb_list.display()))
             })
             .context("cannot start the recording thread")?;

@@ -392,7 +392,7 @@ pub fn write_placement(design: &DesignState, path: &Path) -> anyhow::Result<()> 
     let json = serde_json::to_string_pretty(&Placement {
         world_from_tree: design.world_from_tree.map(|m| m.to_cols_array()),
     })?;
-    std::fs::write(path, json).with_context(|| format!("cannot write {}", path.display()))
+    crate::outputs::write_file(path, json.as_bytes())
 }
 
 /// Writes the tree as `tree.json` (the growth state, in tree space), `tree.glb` (its meshes)

@@ -193,10 +193,23 @@ impl Session {
         for (i, timed) in self.events.iter().enumerate() {
             let why = match &timed.event {
                 InputEvent::Parameters { parameters } => parameters.check().err(),
+                InputEvent::RestoreTree {
+                    tree_file,
+                    world_from_tree,
+                } => crate::autosave::parse_restored_tree(tree_file)
+                    .err()
+                    .or_else(|| {
+                        world_from_tree
+                            .is_some_and(|m| !m.iter().all(|v| v.is_finite()))
+                            .then(|| "a restored tree placed at a non-finite pose".into())
+                    }),
                 InputEvent::Grow { iterations }
-                    if iterations.unsigned_abs() > sylva_core::growth::MAX_ITERATIONS =>
+                    if iterations.unsigned_abs() > crate::state::MAX_ITERATIONS_PER_REQUEST =>
                 {
-                    Some(format!("grows {iterations} iterations at once"))
+                    Some(format!(
+                        "grows {iterations} iterations at once (at most {})",
+                        crate::state::MAX_ITERATIONS_PER_REQUEST
+                    ))
                 }
                 InputEvent::Touch { x, y, .. } if !(x.is_finite() && y.is_finite()) => {
                     Some(format!("touch at ({x}, {y})"))
@@ -239,13 +252,8 @@ impl Session {
         // Compact: a few hundred tracked points per frame make pretty-printing several times
         // larger.
         let json = serde_json::to_string(self)?;
-        // Atomic: a temporary file beside `path`, renamed over it, so a crash mid-write leaves
-        // the previous session whole.
-        let mut temp = path.as_os_str().to_owned();
-        temp.push(".tmp");
-        let temp = PathBuf::from(temp);
-        std::fs::write(&temp, json).with_context(|| format!("cannot write {}", temp.display()))?;
-        std::fs::rename(&temp, path).with_context(|| format!("cannot write {}", path.display()))
+        // Atomic and durable: a crash mid-write leaves the previous session whole.
+        crate::outputs::write_file(path, json.as_bytes())
     }
 }
 
@@ -400,9 +408,7 @@ fn write_frame(
     frame_sha256.push(format!("{:x}", sha2::Sha256::digest(image.as_raw())));
     if let Some(out) = out {
         let path = out.join(format!("frame_{step:04}.png"));
-        image
-            .save(&path)
-            .with_context(|| format!("cannot write {}", path.display()))?;
+        crate::outputs::write_png(image, &path)?;
     }
     Ok(())
 }

@@ -86,6 +86,9 @@ impl Default for Parameters {
 /// The oldest a tree may be grown, in the app or by `sylva grow` (the years slider offers far
 /// less).
 pub const MAX_DESIGN_YEARS: f32 = 1000.0;
+/// Most growth iterations one request (a command, a session's grow event) runs: a thousand
+/// years of a species growing one iteration a year. More would run for hours.
+pub const MAX_ITERATIONS_PER_REQUEST: u32 = 1000;
 
 /// The species a new design starts with.
 pub const DEFAULT_SPECIES: &str = "maple";
@@ -236,6 +239,11 @@ pub enum InputEvent {
     Tool {
         tool: Tool,
     },
+    /// Restores an autosaved design (undoable): the tree file's JSON and where it stood.
+    RestoreTree {
+        tree_file: String,
+        world_from_tree: Option<[f32; 12]>,
+    },
 }
 
 /// A brush stroke.
@@ -323,11 +331,20 @@ fn move_to_iteration(
     scene: Option<(&dyn Scene, SceneMode)>,
 ) -> Result<(), sylva_core::edit::EditError> {
     if target < tree.iteration {
-        return timeline.go_to(tree, target);
+        // A thinned-out iteration: the latest kept one before it, regrown to it when only
+        // autonomous growth happened in between (else the ungrow lands there).
+        let kept = timeline.kept_at_or_before(target).unwrap_or(target);
+        timeline.go_to(tree, kept)?;
+        if timeline.regrows_autonomously(kept, target) {
+            while tree.iteration < target {
+                tree.grow(1, scene);
+            }
+        }
+        return Ok(());
     }
     while tree.iteration < target {
         tree.grow(1, scene);
-        timeline.keep(tree);
+        timeline.keep_autonomous(tree);
     }
     Ok(())
 }
@@ -344,6 +361,13 @@ fn planted(species: Species, seed: u64) -> Tree {
 
 /// Undo steps kept.
 const MAX_UNDO: usize = 64;
+/// Memory of the undo steps and of the timeline, each in multiples of the tree's own size
+/// (`Tree::own_bytes`; the oldest dropped, or thinned, beyond it): with the tree itself the design stays within
+/// about three times the tree's size however long it is edited (see `examples/soak.rs`).
+const UNDO_BUDGET_TREES: f32 = 0.75;
+/// Finished strokes kept (oldest dropped).
+const MAX_FINISHED_STROKES: usize = 16;
+const TIMELINE_BUDGET_TREES: f32 = 0.75;
 
 impl DesignState {
     /// A sapling of `params.species` (the default species for an unknown name) planted at the
@@ -362,13 +386,13 @@ impl DesignState {
         let mut species = species_named(&params.species);
         params.apply_to(&mut species);
         let tree = planted(species, seed);
-        let mut timeline = Timeline::default();
+        let mut timeline = Timeline::with_budget(TIMELINE_BUDGET_TREES);
         timeline.keep(&tree);
         DesignState {
             params,
             tree,
             seed,
-            history: History::new(MAX_UNDO),
+            history: History::new(MAX_UNDO).with_budget(UNDO_BUDGET_TREES),
             timeline,
             stroke: None,
             brush: None,
@@ -389,6 +413,11 @@ impl DesignState {
             grow_debt: 0.0,
             tools: Default::default(),
         }
+    }
+
+    /// Bytes held by the undo snapshots and by the timeline's kept states (the soak report).
+    pub fn snapshot_bytes(&self) -> (usize, usize) {
+        (self.history.snapshot_bytes(), self.timeline.kept_bytes())
     }
 
     /// Number of undo steps available.
@@ -472,7 +501,38 @@ impl DesignState {
             }
             InputEvent::ScaleTool { tool } => self.scale.choose(*tool),
             InputEvent::Tool { tool } => self.choose_tool(*tool),
+            InputEvent::RestoreTree {
+                tree_file,
+                world_from_tree,
+            } => {
+                if let Ok(tree) = crate::autosave::parse_restored_tree(tree_file) {
+                    self.restore_tree(tree, *world_from_tree);
+                }
+            }
         }
+    }
+
+    /// Replaces the design's tree by a restored one (undoable), standing where it stood.
+    fn restore_tree(&mut self, tree: Tree, world_from_tree: Option<[f32; 12]>) {
+        self.history.record(OperationKind::Parameters, &self.tree);
+        self.params = Parameters {
+            brush_radius: self.params.brush_radius,
+            grow_speed: self.params.grow_speed,
+            scene_mode: self.params.scene_mode,
+            season: self.params.season,
+            years: tree.age_years(),
+            ..Parameters::for_species(&tree.species)
+        };
+        self.tree = tree;
+        self.timeline = Timeline::with_budget(TIMELINE_BUDGET_TREES);
+        self.timeline.keep(&self.tree);
+        if let Some(m) = world_from_tree {
+            self.world_from_tree = Some(Affine3A::from_cols_array(&m));
+        }
+        self.brush = None;
+        self.bend = None;
+        self.selected = None;
+        self.changed();
     }
 
     /// New parameters (undoable). Another species starts a seedling of it.
@@ -493,7 +553,7 @@ impl DesignState {
                 ..Parameters::for_species(&species)
             };
             self.tree = planted(species, self.seed);
-            self.timeline = Timeline::default();
+            self.timeline = Timeline::with_budget(TIMELINE_BUDGET_TREES);
             self.timeline.keep(&self.tree);
             self.brush = None;
             self.changed();
@@ -765,6 +825,12 @@ impl DesignState {
             && !stroke.points.is_empty()
         {
             self.finished_strokes.push(stroke);
+            // The latest strokes only: memory must not grow with the length of a session.
+            let excess = self
+                .finished_strokes
+                .len()
+                .saturating_sub(MAX_FINISHED_STROKES);
+            self.finished_strokes.drain(..excess);
         }
     }
 

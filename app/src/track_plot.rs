@@ -33,13 +33,20 @@ pub fn draw(report: &TrackReport, path: &Path) -> anyhow::Result<()> {
         anyhow::bail!("no tracked frames to plot");
     }
     let pad = 0.05 * (x1 - x0).max(y1 - y0).max(1e-3);
-    let root = BitMapBackend::new(path, (800, 800)).into_drawing_area();
-    root.fill(&WHITE)?;
-    let mut chart = ChartBuilder::on(&root)
-        .margin(20)
-        .build_cartesian_2d((x0 - pad)..(x1 + pad), (y0 - pad)..(y1 + pad))?;
-    chart.draw_series(LineSeries::new(truth, BLACK.stroke_width(2)))?;
-    chart.draw_series(LineSeries::new(estimate, RED.stroke_width(2)))?;
-    root.present()?;
-    Ok(())
+    const SIDE: u32 = 800;
+    let mut rgb = vec![0u8; (SIDE * SIDE * 3) as usize];
+    {
+        let root = BitMapBackend::with_buffer(&mut rgb, (SIDE, SIDE)).into_drawing_area();
+        root.fill(&WHITE)?;
+        let mut chart = ChartBuilder::on(&root)
+            .margin(20)
+            .build_cartesian_2d((x0 - pad)..(x1 + pad), (y0 - pad)..(y1 + pad))?;
+        chart.draw_series(LineSeries::new(truth, BLACK.stroke_width(2)))?;
+        chart.draw_series(LineSeries::new(estimate, RED.stroke_width(2)))?;
+        root.present()?;
+    }
+    // Drawn in memory, written atomically like every other output.
+    let image = image::RgbImage::from_raw(SIDE, SIDE, rgb)
+        .ok_or_else(|| anyhow::anyhow!("the plot buffer has the wrong size"))?;
+    crate::outputs::write_png(&image, path)
 }

@@ -74,6 +74,7 @@ fn view_args(video: &Path) -> ViewArgs {
         plant_at_origin: false,
         frame_report: None,
         window_size: (1120, 720),
+        restore: false,
     }
 }
 

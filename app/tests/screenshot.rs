@@ -26,6 +26,7 @@ use sylva_app::scene_tracking::SceneTracker;
 use sylva_tracking::linalg::Similarity;
 use sylva_tracking::metrics::{PosePair, align_frames};
 
+
 const WINDOW: (u32, u32) = (1120, 720);
 
 fn demo() -> PathBuf {
@@ -41,6 +42,10 @@ fn screenshot(
     image: &RgbaImage,
     k: &Intrinsics,
 ) -> RgbaImage {
+    // Each run in a folder of its own: the second would otherwise find the first one's autosave
+    // and offer it back over the footage.
+    let run_dir = dir.join(format!("run-{frame}"));
+    std::fs::create_dir_all(&run_dir).expect("run folder");
     let app = Command::new(env!("CARGO_BIN_EXE_sylva"))
         .arg("view")
         .arg(demo())
@@ -50,7 +55,7 @@ fn screenshot(
             "--paused",
             "--plant-at-origin",
         ])
-        .current_dir(dir)
+        .current_dir(&run_dir)
         .env("DISPLAY", display)
         .env_remove("WAYLAND_DISPLAY")
         .stdout(Stdio::null())

@@ -17,11 +17,11 @@ mod buds;
 mod io;
 mod light;
 mod shoots;
+mod snapshot;
 mod space;
 mod vigor;
 mod widths;
 
-pub(crate) use io::write_atomically;
 pub use io::{TREE_FORMAT_VERSION, TreeFileError};
 pub use widths::solve_pipe_exponent;
 

@@ -23,6 +23,7 @@ pub mod garden;
 pub mod geometry;
 pub mod growth;
 pub mod rng;
+pub mod safe_write;
 pub mod species;
 pub mod tree;
 

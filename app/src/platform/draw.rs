@@ -55,6 +55,20 @@ impl ViewDrawer {
         size: (u32, u32),
         raw: egui::RawInput,
     ) -> egui::PlatformOutput {
+        self.draw_with(gpu, player, target, size, raw, |_, _| {})
+    }
+
+    /// [`Self::draw`] with a shell's own UI (e.g. the desktop's offer of an earlier autosave)
+    /// drawn after the app's, its events going to the player too.
+    pub fn draw_with(
+        &mut self,
+        gpu: &Gpu,
+        player: &mut Player,
+        target: &wgpu::TextureView,
+        size: (u32, u32),
+        raw: egui::RawInput,
+        mut shell_ui: impl FnMut(&mut egui::Ui, &mut Vec<crate::state::InputEvent>),
+    ) -> egui::PlatformOutput {
         let render_started = Instant::now();
         let mut encoder = gpu.device.create_command_encoder(&Default::default());
         self.draw_view(gpu, player, &mut encoder, target, size);
@@ -65,6 +79,7 @@ impl ViewDrawer {
         let output = self.egui_ctx.run_ui(raw, |ui| {
             let mut events = Vec::new();
             let view = crate::ui::sylva_ui(ui, &mut player.ui, &player.design, &mut events);
+            shell_ui(ui, &mut events);
             match orbit.as_mut().filter(|_| player.ui.orbit_view) {
                 Some(orbit) => {
                     let focal =

@@ -15,17 +15,28 @@ impl Drop for Killed {
     }
 }
 
-/// Starts Xvfb on a display numbered `base` plus this process's id modulo 100; returns it with
-/// the display's name (`:N`) once its socket is there.
+/// Starts Xvfb on the first free display from `base` plus this process's id modulo 100;
+/// returns it with the display's name (`:N`) once its socket is there.
 pub fn start_xvfb(base: u32) -> (Killed, String) {
-    let display = format!(":{}", base + std::process::id() % 100);
+    let first = base + std::process::id() % 100;
+    let number = (first..first + 100)
+        .find(|n| !Path::new(&format!("/tmp/.X{n}-lock")).exists())
+        .unwrap_or(first);
+    let display = format!(":{number}");
     let child = Command::new("Xvfb")
-        .args([&display, "-screen", "0", "1280x800x24", "-nolisten", "tcp"])
+        .args([
+            display.as_str(),
+            "-screen",
+            "0",
+            "1280x800x24",
+            "-nolisten",
+            "tcp",
+        ])
         .stdout(Stdio::null())
         .stderr(Stdio::null())
         .spawn()
         .expect("Xvfb is required for this test (apt-get install xvfb)");
-    let socket = format!("/tmp/.X11-unix/X{}", &display[1..]);
+    let socket = format!("/tmp/.X11-unix/X{number}");
     for _ in 0..100 {
         if Path::new(&socket).exists() {
             break;

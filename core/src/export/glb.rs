@@ -27,7 +27,7 @@ pub(super) const CHUNK_BIN: u32 = 0x004E_4942;
 /// Writes `meshes` to `path` as binary glTF 2.0.
 pub fn write_glb(meshes: &TreeMeshes, path: &Path) -> Result<(), ExportError> {
     let bytes = build(meshes, path)?;
-    std::fs::write(path, bytes).map_err(ExportError::io(path))
+    crate::safe_write::write_file(path, &bytes).map_err(ExportError::io(path))
 }
 
 /// `meshes` as the bytes of a binary glTF 2.0 file.

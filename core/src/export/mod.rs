@@ -30,7 +30,7 @@ use std::path::{Path, PathBuf};
 
 pub use garden::{SceneTree, garden_glb_bytes, write_garden_glb, write_garden_obj};
 pub use glb::{glb_bytes, write_glb};
-pub use obj::write_obj;
+pub use obj::{obj_files, write_obj};
 
 /// Side length of the generated bark and leaf textures, pixels.
 pub const TEXTURE_SIZE: u32 = 256;

@@ -21,16 +21,8 @@ pub fn write_obj(meshes: &TreeMeshes, path: &Path) -> Result<(), ExportError> {
             path: path.to_path_buf(),
         });
     }
-    let stem = path
-        .file_stem()
-        .and_then(|s| s.to_str())
-        .filter(|s| !s.is_empty())
-        .unwrap_or("tree")
-        .to_string();
+    let [mtl_name, bark_name, leaf_name] = companion_names(path);
     let sibling = |name: String| -> PathBuf { path.with_file_name(name) };
-    let mtl_name = format!("{stem}.mtl");
-    let bark_name = format!("{stem}_bark.png");
-    let leaf_name = format!("{stem}_leaf.png");
     write_png(
         &sibling(bark_name.clone()),
         &bark_texture(meshes.colors.bark_kind, meshes.colors.bark, TEXTURE_SIZE),
@@ -43,8 +35,6 @@ pub fn write_obj(meshes: &TreeMeshes, path: &Path) -> Result<(), ExportError> {
     )?;
     write_mtl(&sibling(mtl_name.clone()), meshes, &bark_name, &leaf_name)?;
 
-    let file = File::create(path).map_err(ExportError::io(path))?;
-    let mut out = BufWriter::with_capacity(1 << 20, file);
     let parts: [(&str, &str, &TreeMesh, usize); 3] = [
         (
             "branches",
@@ -84,7 +74,29 @@ pub fn write_obj(meshes: &TreeMeshes, path: &Path) -> Result<(), ExportError> {
         }
         out.flush()
     };
-    write_all(&mut out).map_err(ExportError::io(path))
+    crate::safe_write::write_file_with(path, write_all).map_err(ExportError::io(path))
+}
+
+/// The names of the files [`write_obj`] writes next to `path`: its MTL, bark and leaf PNGs.
+fn companion_names(path: &Path) -> [String; 3] {
+    let stem = path
+        .file_stem()
+        .and_then(|s| s.to_str())
+        .filter(|s| !s.is_empty())
+        .unwrap_or("tree");
+    [
+        format!("{stem}.mtl"),
+        format!("{stem}_bark.png"),
+        format!("{stem}_leaf.png"),
+    ]
+}
+
+/// Every file [`write_obj`] writes for `path`: the OBJ, its MTL and the two textures (for
+/// checking a command's outputs before it runs).
+pub fn obj_files(path: &Path) -> Vec<PathBuf> {
+    let mut files = vec![path.to_path_buf()];
+    files.extend(companion_names(path).map(|name| path.with_file_name(name)));
+    files
 }
 
 fn write_png<P>(
@@ -101,7 +113,7 @@ where
         what,
         reason: e.to_string(),
     })?;
-    std::fs::write(path, bytes).map_err(ExportError::io(path))
+    crate::safe_write::write_file(path, &bytes).map_err(ExportError::io(path))
 }
 
 fn write_mtl(
@@ -117,5 +129,5 @@ fn write_mtl(
          newmtl leaf\nKa 0 0 0\nKd 1 1 1\nKs 0.05 0.05 0.05\nNs 16\nillum 2\nmap_Kd {leaf_png}\nmap_d -imfchan m {leaf_png}\n\n\
          newmtl fruit\nKa 0 0 0\nKd {fr} {fg} {fb}\nKs 0.3 0.3 0.3\nNs 64\nillum 2\n"
     );
-    std::fs::write(path, text).map_err(ExportError::io(path))
+    crate::safe_write::write_file(path, text.as_bytes()).map_err(ExportError::io(path))
 }

@@ -161,7 +161,7 @@ impl Garden {
     pub fn save(&self, path: impl AsRef<Path>) -> Result<(), GardenFileError> {
         let path = path.as_ref();
         let shown = path.display().to_string();
-        crate::growth::write_atomically(path, &self.to_json_bytes()).map_err(|source| {
+        crate::safe_write::write_file(path, &self.to_json_bytes()).map_err(|source| {
             GardenFileError::Write {
                 path: shown,
                 source,

@@ -58,18 +58,6 @@ struct FileIn {
     tree: Tree,
 }
 
-/// Writes `bytes` to a temporary file next to `path`, then renames it over `path`: a reader
-/// sees the old file or the new one, never a part.
-pub(crate) fn write_atomically(path: &Path, bytes: &[u8]) -> std::io::Result<()> {
-    let mut temp_name = path.file_name().unwrap_or_default().to_os_string();
-    temp_name.push(".tmp");
-    let temp = path.with_file_name(temp_name);
-    std::fs::write(&temp, bytes)?;
-    std::fs::rename(&temp, path).inspect_err(|_| {
-        let _ = std::fs::remove_file(&temp);
-    })
-}
-
 impl Tree {
     /// The tree as versioned JSON bytes (deterministic).
     pub fn to_json_bytes(&self) -> Result<Vec<u8>, TreeFileError> {
@@ -145,7 +133,7 @@ impl Tree {
         Self::from_json_bytes_named(bytes, "<bytes>")
     }
 
-    /// Saves atomically: writes a temporary file next to `path`, then renames it over `path`.
+    /// Saves atomically and durably ([`crate::safe_write`]): a reader sees the old file or the new one.
     pub fn save(&self, path: impl AsRef<Path>) -> Result<(), TreeFileError> {
         let path = path.as_ref();
         let shown = path.display().to_string();
@@ -156,7 +144,7 @@ impl Tree {
             },
             other => other,
         })?;
-        write_atomically(path, &bytes).map_err(|source| TreeFileError::Write {
+        crate::safe_write::write_file(path, &bytes).map_err(|source| TreeFileError::Write {
             path: shown,
             source,
         })
