@@ -8,7 +8,7 @@ use crate::footage::Footage;
 use crate::session::replay;
 
 /// The bundled demo sequence, relative to the workspace root.
-pub const DEMO_SEQUENCE: &str = "test-data/demo_garden";
+pub const DEMO_SEQUENCE: &str = "test-data/demo_yard";
 
 #[derive(clap::Args, Debug)]
 pub struct ReplayArgs {
@@ -111,7 +111,7 @@ pub fn demo() -> anyhow::Result<()> {
     }
     let out = PathBuf::from("out/demo");
     let footage = Footage::open(&sequence)?;
-    let session = crate::demo_script::demo_session(&footage, sequence.clone())?;
+    let session = crate::demo_script::yard_session(&footage, sequence.clone())?;
     // The demo's own folder: an earlier demo's frames are removed, not left beside the new ones.
     crate::outputs::prepare_replay_folder(&out, true)?;
     let session_path = out.join("demo-session.json");

@@ -72,6 +72,49 @@ pub fn tap(pixel: Vec2) -> [InputEvent; 2] {
     ]
 }
 
+/// The app's demo sequence (`test-data/demo_yard`): the frame of the planting tap, and the pixel
+/// tapped there, on the lawn just behind the box (in the sequence's 640 × 480 frames).
+pub const YARD_TAP_FRAME: usize = 30;
+pub const YARD_TAP_PIXEL: Vec2 = Vec2::new(361.0, 243.0);
+/// The tree the demo plants, and its age in years.
+pub const YARD_SPECIES: &str = "norway_spruce";
+pub const YARD_YEARS: f32 = 12.0;
+
+/// The app's first impression on `test-data/demo_yard`: a tap on the lawn behind the box plants
+/// a seedling there, which is made a Norway spruce of 12 years at once; the walk then goes round
+/// so that the box hides the tree's foot while its crown stands in view.
+pub fn yard_session(footage: &Footage, footage_ref: PathBuf) -> anyhow::Result<Session> {
+    let species = sylva_core::species::Species::by_name(YARD_SPECIES)?;
+    // The tap is made in the sequence's pixels; frames of another size get it scaled.
+    let [sx, sy] = [
+        footage.intrinsics.width as f32 / 640.0,
+        footage.intrinsics.height as f32 / 480.0,
+    ];
+    let mut planted_at = None;
+    scripted_session(
+        footage,
+        footage_ref,
+        Parameters::default(),
+        |step, state| {
+            let mut events = Vec::new();
+            if step == YARD_TAP_FRAME {
+                events.extend(tap(YARD_TAP_PIXEL * Vec2::new(sx, sy)));
+            } else if planted_at.is_none() && step > YARD_TAP_FRAME && state.is_planted() {
+                // The species first (a new species starts a new seedling), then its age.
+                planted_at = Some(step);
+                events.push(InputEvent::Parameters {
+                    parameters: Parameters::for_species(&species),
+                });
+            } else if planted_at.is_some_and(|at| step == at + 1) {
+                let mut parameters = state.params.clone();
+                parameters.years = YARD_YEARS;
+                events.push(InputEvent::Parameters { parameters });
+            }
+            events
+        },
+    )
+}
+
 /// Builds the demo session over every frame of `footage` (referenced as `footage_ref`).
 pub fn demo_session(footage: &Footage, footage_ref: PathBuf) -> anyhow::Result<Session> {
     let n = footage.len();

@@ -14,7 +14,9 @@ use std::path::Path;
 use std::sync::Arc;
 
 use glam::{Affine3A, Mat4, Vec3};
-use sylva_tracking::depth_mesh::{DepthMesh, DepthMeshConfig, Observation, PinholeIntrinsics};
+use sylva_tracking::depth_mesh::{
+    DepthMesh, DepthMeshConfig, GroundSolids, GroundSolidsConfig, Observation, PinholeIntrinsics,
+};
 use sylva_tracking::occupancy::{OccupancyConfig, OccupancyMap};
 
 use crate::render::{GroundPlane, Intrinsics, OccluderMesh};
@@ -36,21 +38,26 @@ pub struct SceneFrame {
     pub tracking_ms: f32,
 }
 
-/// The incremental depth mesh of the tracked points, turned into the renderer's occluder. Live
-/// tracking and session replays feed it the same observations, so they draw the same occluder.
+/// The incremental depth mesh of the tracked points, turned into the renderer's occluder, with
+/// the solids standing on the ground that the tracked points of all frames since the ground was
+/// found make ([`GroundSolids`]). Live tracking and session replays feed it the same
+/// observations in the same order, so they draw the same occluder.
 pub struct SceneMesher {
     depth_mesh: DepthMesh,
+    solids: GroundSolids,
 }
 
 impl SceneMesher {
     pub fn new(intrinsics: &Intrinsics) -> SceneMesher {
         SceneMesher {
             depth_mesh: DepthMesh::new(pinhole_of(intrinsics), DepthMeshConfig::default()),
+            solids: GroundSolids::new(GroundSolidsConfig::default()),
         }
     }
 
     /// Updates the mesh with one frame's observations and returns it in the world, filled down
-    /// to the ground contact once the ground is known ([`skirt_to_ground`]).
+    /// to the ground contact once the ground is known ([`skirt_to_ground`]), with the solids on
+    /// the ground.
     pub fn update(
         &mut self,
         observations: &[Observation],
@@ -68,6 +75,21 @@ impl SceneMesher {
         };
         if let Some(ground) = ground {
             skirt_to_ground(&mut occluder, &ground);
+            // The world is fixed once the ground is found (refits of the plane do not move
+            // it), so the points of every frame since then are fused in one world.
+            self.solids.observe(
+                observations,
+                self.depth_mesh.camera(),
+                &Affine3A::from_mat4(world_from_camera),
+                ground.point,
+                ground.normal,
+            );
+            self.solids.append_mesh(
+                ground.point,
+                ground.normal,
+                &mut occluder.positions,
+                &mut occluder.indices,
+            );
         }
         occluder
     }

@@ -52,8 +52,13 @@ pub struct StageTimings {
 pub struct TrackReport {
     pub sequence: PathBuf,
     pub frames: usize,
+    /// Frames that had a pose when the tracker returned them (when an app would show them).
     pub tracked_frames: usize,
+    /// `tracked_frames` over all frames.
     pub tracked_fraction: f64,
+    /// Frames whose pose was found only later (the initializer's back-filled frames before
+    /// the first map, relocalised frames): counted in the errors, not in `tracked_fraction`.
+    pub late_posed_frames: usize,
     pub errors: Option<TrajectoryErrors>,
     pub median_decode_ms: f64,
     /// Median tracking time per frame, decode excluded.
@@ -137,6 +142,7 @@ pub fn run_sequence_scaled(
     let mut outputs: Vec<FrameOutput> = Vec::new();
     let mut timings = StageTimings::default();
     let mut skipped = Vec::new();
+    let mut num_posed_when_shown = 0;
     let mut done = 0;
     loop {
         let start = Instant::now();
@@ -151,6 +157,7 @@ pub fn run_sequence_scaled(
                 let start = Instant::now();
                 let output = tracker.track(&frame, up.map(|u| u * 9.81))?;
                 timings.track_ms.push(start.elapsed().as_secs_f64() * 1e3);
+                num_posed_when_shown += usize::from(output.world_from_camera.is_some());
                 outputs.push(output);
                 for late in tracker.take_late_poses() {
                     if let Some(o) = outputs.iter_mut().find(|o| o.index == late.index) {
@@ -183,7 +190,13 @@ pub fn run_sequence_scaled(
     }
     let scale = run_scale(&outputs, &sequence.camera, num_frames, options)?;
     Ok(summarise(
-        &sequence, &tracker, outputs, timings, skipped, scale,
+        &sequence,
+        &tracker,
+        outputs,
+        num_posed_when_shown,
+        timings,
+        skipped,
+        scale,
     ))
 }
 
@@ -199,6 +212,7 @@ fn summarise(
     sequence: &TumSequence,
     tracker: &Tracker,
     outputs: Vec<FrameOutput>,
+    num_posed_when_shown: usize,
     timings: StageTimings,
     skipped: Vec<SkippedFrame>,
     scale: RunScale,
@@ -264,8 +278,9 @@ fn summarise(
     TrackReport {
         sequence: sequence.root.clone(),
         frames,
-        tracked_frames: tracked.len(),
-        tracked_fraction: tracked.len() as f64 / frames.max(1) as f64,
+        tracked_frames: num_posed_when_shown,
+        tracked_fraction: num_posed_when_shown as f64 / frames.max(1) as f64,
+        late_posed_frames: tracked.len().saturating_sub(num_posed_when_shown),
         errors,
         median_decode_ms: median(timings.decode_ms.clone()),
         ms_per_frame: median(timings.track_ms.clone()),
@@ -321,8 +336,8 @@ impl TrackReport {
     /// once there is a scale).
     pub fn summary_line(&self) -> String {
         let mut line = format!(
-            "frames={} tracked_fraction={:.3}",
-            self.frames, self.tracked_fraction
+            "frames={} tracked_fraction={:.3} late_posed_frames={}",
+            self.frames, self.tracked_fraction, self.late_posed_frames
         );
         if let Some(e) = &self.errors {
             line += &format!(

@@ -1,6 +1,6 @@
 //! Renders a synthetic TUM-layout garden sequence.
 //!
-//! `make_synthetic --out DIR [--preset demo|slope|forced-loss|tree-a|tree-b] [--seed N] [--frames N]
+//! `make_synthetic --out DIR [--preset demo|demo-yard|slope|forced-loss|tree-a|tree-b] [--seed N] [--frames N]
 //!  [--size WxH] [--quality Q | --png] [--depth-every N] [--no-blur] [--no-exposure]
 //!  [--blank START..END]`
 //!
@@ -11,7 +11,7 @@ use std::process::ExitCode;
 
 use sylva_tests::synthetic::{FrameFormat, SequenceOptions, render_sequence};
 
-const USAGE: &str = "usage: make_synthetic --out DIR [--preset demo|slope|forced-loss|tree-a|tree-b] [--seed N] [--frames N] \
+const USAGE: &str = "usage: make_synthetic --out DIR [--preset demo|demo-yard|slope|forced-loss|tree-a|tree-b] [--seed N] [--frames N] \
 [--size WxH] [--quality Q | --png] [--depth-every N] [--no-blur] [--no-exposure] [--blank START..END]";
 
 fn parse_number<T: std::str::FromStr>(flag: &str, value: Option<String>) -> Result<T, String> {
@@ -31,13 +31,14 @@ fn parse_args() -> Result<(SequenceOptions, PathBuf), String> {
             "--preset" => {
                 let seed_free = match args.next().as_deref() {
                     Some("demo") => SequenceOptions::demo_garden(),
+                    Some("demo-yard") => SequenceOptions::demo_yard(),
                     Some("slope") => SequenceOptions::slope(),
                     Some("forced-loss") => SequenceOptions::forced_loss(),
                     Some("tree-a") => SequenceOptions::tree_a(),
                     Some("tree-b") => SequenceOptions::tree_b(),
                     other => {
                         return Err(format!(
-                            "unknown preset {other:?} (demo, slope, forced-loss, tree-a, tree-b)"
+                            "unknown preset {other:?} (demo, demo-yard, slope, forced-loss, tree-a, tree-b)"
                         ));
                     }
                 };

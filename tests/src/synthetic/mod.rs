@@ -181,6 +181,23 @@ impl SequenceOptions {
         }
     }
 
+    /// The app's demo (`test-data/demo_yard`): the same garden walked at 9 m from the spot with
+    /// the camera held nearly level (8° down), so a tree of 12–15 years (4–5 m) behind the box is
+    /// in view from its foot (hidden by the box) to its crown.
+    pub fn demo_yard() -> Self {
+        Self {
+            seed: 2029,
+            walk: WalkParams {
+                radius_m: 9.0,
+                pitch_deg: 8.0,
+                start_bearing_deg: -25.0,
+                end_bearing_deg: 25.0,
+                ..WalkParams::default()
+            },
+            ..Self::demo_garden()
+        }
+    }
+
     /// The demo walk with one second of blanked frames starting at frame 120.
     pub fn forced_loss() -> Self {
         Self {

@@ -19,12 +19,17 @@
 //! a camera height from it, while a triangle bridging a pole and the wall behind it passes
 //! within centimetres.
 //!
+//! **Solids on the ground.** [`GroundSolids`] keeps every tracked point in the world over the
+//! frames and raises the groups of points above the ground into prisms standing on it: the
+//! faces of plain objects, where one frame tracks too few points, still occlude.
+//!
 //! **Spaces.** Pixels: the tracker's undistorted pixel coordinates (`u` right, `v` down).
 //! Camera space: OpenCV (X right, Y down, Z forward), metres;
 //! depth is camera Z. `world_from_camera` maps camera space into the world (metres, Y up).
 
 mod consistency;
 mod export;
+mod ground_solids;
 mod layer;
 mod mesh;
 mod query;
@@ -36,6 +41,7 @@ mod proptests;
 mod tests;
 
 pub use export::OcclusionMesh;
+pub use ground_solids::{GroundSolid, GroundSolids, GroundSolidsConfig};
 pub use mesh::{DepthMesh, MeshVertex, UpdateStats};
 pub use query::{DepthSample, UnknownReason};
 
