@@ -117,6 +117,8 @@ pub fn demo() -> anyhow::Result<()> {
     let session_path = out.join("demo-session.json");
     let mut absolute = session.clone();
     absolute.footage = std::fs::canonicalize(&sequence).unwrap_or(sequence);
+    // The first impression at the footage's own size (recorded sessions keep their smaller one).
+    absolute.frame_size = [footage.intrinsics.width, footage.intrinsics.height];
     absolute.save(&session_path)?;
     let report = replay(&session_path, Some(&out), true, |_, _| {})?;
     println!(

@@ -362,9 +362,12 @@ fn planted(species: Species, seed: u64) -> Tree {
 /// Undo steps kept.
 const MAX_UNDO: usize = 64;
 /// Memory of the undo steps and of the timeline, each in multiples of the tree's own size
-/// (`Tree::own_bytes`; the oldest dropped, or thinned, beyond it): with the tree itself the design stays within
-/// about three times the tree's size however long it is edited (see `examples/soak.rs`).
-const UNDO_BUDGET_TREES: f32 = 0.75;
+/// (`Tree::own_bytes`; the oldest dropped, or thinned, beyond it), so the design stays within a
+/// few times the tree's size however long it is edited (see `examples/soak.rs`). The undo
+/// budget keeps several whole-tree steps of a large tree (at 0.75 only about two were left,
+/// too few to take back a years change and the edits before it); snapshots are whole compact
+/// trees, so a smaller bound needs undo steps stored as differences.
+const UNDO_BUDGET_TREES: f32 = 4.0;
 /// Finished strokes kept (oldest dropped).
 const MAX_FINISHED_STROKES: usize = 16;
 const TIMELINE_BUDGET_TREES: f32 = 0.75;

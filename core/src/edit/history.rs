@@ -102,12 +102,22 @@ impl History {
         self.fit_budget(current_bytes);
     }
 
-    /// Drops the oldest undo steps, then the farthest redo steps, beyond the byte budget.
+    /// Drops the oldest undo steps, then the farthest redo steps, beyond the byte budget. The
+    /// budget is a multiple of the largest tree the steps hold or the current one, so undoing
+    /// back to a smaller tree does not drop the steps before it to make room for the redo.
     fn fit_budget(&mut self, current_bytes: usize) {
         if self.budget_trees <= 0.0 {
             return;
         }
-        let budget = (f64::from(self.budget_trees) * current_bytes as f64) as usize;
+        let largest = self
+            .undo
+            .iter()
+            .chain(&self.redo)
+            .map(|s| s.bytes)
+            .max()
+            .unwrap_or(0)
+            .max(current_bytes);
+        let budget = (f64::from(self.budget_trees) * largest as f64) as usize;
         let mut total: usize = self.undo.iter().chain(&self.redo).map(|s| s.bytes).sum();
         while total > budget && self.undo.len() > 1 {
             total -= self.undo.remove(0).bytes;
