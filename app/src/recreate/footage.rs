@@ -4,13 +4,10 @@
 //! (the median camera height against the holding height, as `sylva track` measures it) is one
 //! factor about the world origin, which lies on the ground.
 
-use std::collections::BTreeMap;
 use std::path::Path;
 
-use anyhow::Context;
 use glam::{DAffine3, DVec2, DVec3};
-use sylva_tracking::scale::CameraHeights;
-use sylva_tracking::{Camera, FrameSource, Plane, SourceEvent, TrackingState, TumSequence};
+use sylva_tracking::{Camera, Plane};
 
 /// One map point: its id and latest position (metres), and the frames that saw it.
 #[derive(Clone, Debug)]
@@ -67,6 +64,10 @@ impl TrackedFootage {
 /// Tracks the TUM-layout footage at `root` with the tracker's defaults and `holding_height_m`.
 #[cfg(not(any(target_os = "android", target_os = "ios")))]
 pub fn track_footage(root: &Path, holding_height_m: f64) -> anyhow::Result<TrackedFootage> {
+    use anyhow::Context;
+    use std::collections::BTreeMap;
+    use sylva_tracking::scale::CameraHeights;
+    use sylva_tracking::{FrameSource, SourceEvent, TrackingState, TumSequence};
     use sylva_tracking::{Tracker, TrackerConfig};
     let sequence = TumSequence::open(root)
         .with_context(|| format!("cannot open {} for tracking", root.display()))?;
