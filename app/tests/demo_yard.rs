@@ -8,9 +8,10 @@
 //!
 //! Run: `XDG_RUNTIME_DIR=/tmp/sylva-xdg WGPU_BACKEND=vulkan cargo test --release -p sylva-app --test demo_yard -- --nocapture`
 
+mod expected;
+
 use std::path::PathBuf;
 
-use serde::{Deserialize, Serialize};
 use sylva_app::demo_script::{YARD_TAP_FRAME, yard_session};
 use sylva_app::footage::Footage;
 use sylva_app::planting::{camera_in_tree, occluder_in_tree};
@@ -19,13 +20,6 @@ use sylva_app::render::{FrameView, Gpu, Offscreen, Renderer, TreeMesh};
 use sylva_app::scene_tracking::SceneMesher;
 use sylva_app::session::{Session, frame_camera, replay};
 use sylva_app::tree_model::mesh_of;
-
-#[derive(Serialize, Deserialize, PartialEq, Debug)]
-struct Expected {
-    tree_sha256: String,
-    frames: usize,
-    frame_sha256: Vec<String>,
-}
 
 /// The frame the README's picture shows, and where the box is in front of the tree's foot.
 const SHOWN_FRAME: usize = 120;
@@ -148,31 +142,6 @@ fn the_demo_yard_session_plants_a_spruce_behind_the_box_with_its_crown_in_view_a
         "part of the tree hidden, most shown: {num_hidden} of {num_tree} pixels hidden"
     );
 
-    let actual = Expected {
-        tree_sha256: report.tree_sha256.clone(),
-        frames: report.num_frames,
-        frame_sha256: report.frame_sha256.clone(),
-    };
-    if bless {
-        std::fs::write(
-            &expected_path,
-            serde_json::to_string_pretty(&actual).expect("json"),
-        )
-        .expect("write expected");
-    }
-    let expected: Expected =
-        serde_json::from_str(&std::fs::read_to_string(&expected_path).expect("expected file"))
-            .expect("expected json");
-    assert_eq!(actual.tree_sha256, expected.tree_sha256, "tree differs");
-    assert_eq!(actual.frames, expected.frames);
-    let first_bad = actual
-        .frame_sha256
-        .iter()
-        .zip(&expected.frame_sha256)
-        .position(|(a, e)| a != e);
-    assert_eq!(
-        first_bad, None,
-        "frame checksums differ from frame {first_bad:?} on"
-    );
+    expected::assert_replay_matches(&report, &expected_path, bless);
     println!("{}", report.summary_line());
 }

@@ -5,19 +5,13 @@
 //!
 //! Run: `XDG_RUNTIME_DIR=/tmp/sylva-xdg WGPU_BACKEND=vulkan cargo test --release -p sylva-app --test replay`
 
+mod expected;
+
 use std::path::PathBuf;
 
-use serde::{Deserialize, Serialize};
 use sylva_app::footage::Footage;
 use sylva_app::session::{Session, replay};
 use sylva_app::state::{InputEvent, TouchPhase};
-
-#[derive(Serialize, Deserialize, PartialEq, Debug)]
-struct Expected {
-    tree_sha256: String,
-    frames: usize,
-    frame_sha256: Vec<String>,
-}
 
 fn sessions_dir() -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/sessions")
@@ -72,31 +66,6 @@ fn the_committed_demo_session_replays_to_the_committed_tree_and_frames() {
         "the double tap must prune"
     );
 
-    let actual = Expected {
-        tree_sha256: report.tree_sha256.clone(),
-        frames: report.num_frames,
-        frame_sha256: report.frame_sha256.clone(),
-    };
-    if bless {
-        std::fs::write(
-            &expected_path,
-            serde_json::to_string_pretty(&actual).expect("json"),
-        )
-        .expect("write expected");
-    }
-    let expected: Expected =
-        serde_json::from_str(&std::fs::read_to_string(&expected_path).expect("expected file"))
-            .expect("expected json");
-    assert_eq!(actual.tree_sha256, expected.tree_sha256, "tree differs");
-    assert_eq!(actual.frames, expected.frames);
-    let first_bad = actual
-        .frame_sha256
-        .iter()
-        .zip(&expected.frame_sha256)
-        .position(|(a, e)| a != e);
-    assert_eq!(
-        first_bad, None,
-        "frame checksums differ from frame {first_bad:?} on"
-    );
+    expected::assert_replay_matches(&report, &expected_path, bless);
     println!("{}", report.summary_line());
 }
