@@ -1,6 +1,7 @@
 //! Times autonomous growth to 10k, 100k and 300k internodes and one brush-guided iteration on a
-//! 20k-internode tree (the trees of `benches/growth.rs`), printing wall-clock and thread CPU time
-//! per size and per iteration, so the scaling can be read directly.
+//! 20k-internode tree (the trees of `benches/growth.rs`), printing wall-clock, thread CPU and
+//! process CPU time (all threads: growth runs on rayon's pool, `RAYON_NUM_THREADS`) per size and
+//! per iteration, so the scaling can be read directly.
 //!
 //! `cargo run --release -p sylva-core --example growth_timing [max_internodes]`
 //!
@@ -17,10 +18,14 @@ use growth_trees::{brush_iteration, brush_points, grow_to_with, next_brush_tree}
 mod digest;
 #[path = "../benches/common/thread_cpu.rs"]
 mod thread_cpu;
-use thread_cpu::thread_cpu_ns;
+use thread_cpu::{process_cpu_ns, thread_cpu_ns};
 
 fn cpu_ms(start: Option<u64>) -> f64 {
-    match (start, thread_cpu_ns()) {
+    elapsed_ms(start, thread_cpu_ns())
+}
+
+fn elapsed_ms(start: Option<u64>, now: Option<u64>) -> f64 {
+    match (start, now) {
         (Some(a), Some(b)) => (b - a) as f64 / 1e6,
         _ => f64::NAN,
     }
@@ -42,7 +47,7 @@ fn main() {
         if target > max {
             break;
         }
-        let (wall, cpu) = (Instant::now(), thread_cpu_ns());
+        let (wall, cpu, all_cpu) = (Instant::now(), thread_cpu_ns(), process_cpu_ns());
         let (mut w, mut c) = (Instant::now(), thread_cpu_ns());
         let tree = grow_to_with(target, |tree, stats| {
             if verbose {
@@ -62,12 +67,14 @@ fn main() {
             (w, c) = (Instant::now(), thread_cpu_ns());
         });
         println!(
-            "grow to {:>6} internodes ({} reached in {} iterations): {:8.1} ms wall, {:8.1} ms cpu",
+            "grow to {:>6} internodes ({} reached in {} iterations): {:8.1} ms wall, {:8.1} ms cpu, {:8.1} ms cpu on {} threads",
             target,
             tree.skeleton.len(),
             tree.iteration,
             wall.elapsed().as_secs_f64() * 1e3,
-            cpu_ms(cpu)
+            cpu_ms(cpu),
+            elapsed_ms(all_cpu, process_cpu_ns()),
+            rayon::current_num_threads()
         );
         if digests {
             println!("  digest {}", digest(&tree));

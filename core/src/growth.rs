@@ -16,6 +16,7 @@
 mod buds;
 mod io;
 mod light;
+mod parallel;
 mod shoots;
 mod snapshot;
 mod space;
@@ -105,6 +106,12 @@ pub(crate) struct Scratch {
     pub node_grid: crate::environment::SpatialGrid,
     pub point_grid: crate::environment::SpatialGrid,
     pub point_alive: Vec<bool>,
+    /// Runs of `point_grid`'s cells, the blocks of the parallel passes ([`parallel`]).
+    pub point_runs: Vec<std::ops::Range<usize>>,
+    /// Whether each point survived occupancy, and its winner, by slot of `point_grid` (the
+    /// parallel passes' results before they go to `point_alive` and `point_winner`).
+    pub slot_alive: Vec<bool>,
+    pub slot_winner: Vec<(u32, Vec3)>,
     /// Competing nodes near one cell of attraction points (colonization).
     pub candidates: crate::environment::Candidates,
     /// The bud each attraction point feeds and the unit vector from it to the point

@@ -6,6 +6,23 @@
 
 /// Nanoseconds this thread has run on a CPU; `None` where the clock is missing.
 pub fn thread_cpu_ns() -> Option<u64> {
+    cpu_clock_ns(
+        #[cfg(unix)]
+        libc::CLOCK_THREAD_CPUTIME_ID,
+    )
+}
+
+/// Nanoseconds all threads of this process have run on a CPU (growth runs on several);
+/// `None` where the clock is missing.
+#[allow(dead_code)]
+pub fn process_cpu_ns() -> Option<u64> {
+    cpu_clock_ns(
+        #[cfg(unix)]
+        libc::CLOCK_PROCESS_CPUTIME_ID,
+    )
+}
+
+fn cpu_clock_ns(#[cfg(unix)] clock: libc::clockid_t) -> Option<u64> {
     #[cfg(unix)]
     {
         let mut ts = libc::timespec {
@@ -13,7 +30,7 @@ pub fn thread_cpu_ns() -> Option<u64> {
             tv_nsec: 0,
         };
         // SAFETY: `ts` is a valid, writable timespec; the call only writes to it.
-        let status = unsafe { libc::clock_gettime(libc::CLOCK_THREAD_CPUTIME_ID, &mut ts) };
+        let status = unsafe { libc::clock_gettime(clock, &mut ts) };
         (status == 0).then(|| ts.tv_sec as u64 * 1_000_000_000 + ts.tv_nsec as u64)
     }
     #[cfg(not(unix))]

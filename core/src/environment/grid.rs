@@ -205,6 +205,48 @@ impl SpatialGrid {
         })
     }
 
+    /// Splits the cells into consecutive runs of whole cells, each holding at least
+    /// `min_entries` entries (the last one may hold fewer), into `runs` as ranges of cells: the
+    /// blocks of work of a parallel pass over the grid ([`SpatialGrid::cells_in`]).
+    pub fn cell_runs(&self, min_entries: usize, runs: &mut Vec<std::ops::Range<usize>>) {
+        runs.clear();
+        let num_cells = self.cell_start.len().saturating_sub(1);
+        let mut first = 0;
+        for c in 0..num_cells {
+            if (self.cell_start[c + 1] - self.cell_start[first]) as usize >= min_entries.max(1) {
+                runs.push(first..c + 1);
+                first = c + 1;
+            }
+        }
+        if first < num_cells && self.cell_start[num_cells] > self.cell_start[first] {
+            runs.push(first..num_cells);
+        }
+    }
+
+    /// The slots of the entries of cells `cells` (a range of [`SpatialGrid::cell_runs`]).
+    pub fn slots_of(&self, cells: std::ops::Range<usize>) -> std::ops::Range<usize> {
+        self.cell_start[cells.start] as usize..self.cell_start[cells.end] as usize
+    }
+
+    /// [`SpatialGrid::cells`] for the cells `cells` only, each with its first slot.
+    pub fn cells_in(
+        &self,
+        cells: std::ops::Range<usize>,
+    ) -> impl Iterator<Item = (usize, &[u32], &[Vec3])> + '_ {
+        self.cell_start[cells.start..=cells.end]
+            .windows(2)
+            .filter_map(|w| {
+                let (start, end) = (w[0] as usize, w[1] as usize);
+                (start < end).then(|| {
+                    (
+                        start,
+                        &self.entry_index[start..end],
+                        &self.entry_position[start..end],
+                    )
+                })
+            })
+    }
+
     /// Gathers, in scan order, every stored point in the cells that overlap the box `lo..=hi`
     /// grown by `radius` on every side (a superset of the points within `radius` of any point of
     /// the box) into `out`, replacing its contents.

@@ -3,11 +3,15 @@
 //! angle ψ from the heading, in the internode's HLU frame.
 
 use glam::Vec3;
+use rayon::prelude::*;
 
 use super::{Scratch, Tree};
 use crate::environment::clear_with_room;
 use crate::species::{Phyllotaxis, Species};
 use crate::tree::Internode;
+
+/// Nodes per block of the parallel pass over the tree (a block outweighs handing it over).
+const PARALLEL_NODES: usize = 4096;
 
 /// Slot of a terminal bud in [`BudState::slot`]; lateral buds use their index.
 pub(crate) const TERMINAL: u32 = u32::MAX;
@@ -43,9 +47,10 @@ fn bud_cutoff(tree: &Tree) -> Option<u32> {
     tree.iteration.checked_sub(lifetime)
 }
 
-/// One pass over the tree: kills lateral buds older than the bud lifetime, fills
-/// `scratch.buds` with every living bud, node by node (terminal first), with the mask, and
-/// sets the light exposure L of every node that has buds (step 1, [`super::light`]).
+/// Two passes over the tree (the first on all threads): kills lateral buds older than the bud
+/// lifetime, sets the light exposure L of every node that has buds (step 1, [`super::light`]),
+/// then fills `scratch.buds` with every living bud, node by node (terminal first), with the
+/// mask.
 pub(crate) fn collect(tree: &mut Tree, scratch: &mut Scratch) {
     let cutoff = bud_cutoff(tree);
     // Nodes born before `expired` had every lateral bud killed by an earlier pass of this tree
@@ -84,16 +89,30 @@ pub(crate) fn collect(tree: &mut Tree, scratch: &mut Scratch) {
     }
     let (species, shadow) = (&tree.species, &tree.environment.shadow);
     let light_matters = species.light_sensitivity > 0.0;
-    for (i, node) in nodes.iter_mut().enumerate() {
-        let expired_before = node.born_iteration < expired;
-        if !expired_before
-            && cutoff.is_some_and(|c| node.born_iteration < c)
-            && node.lateral_buds.iter().any(|b| b.alive)
-        {
-            for bud in &mut node.lateral_buds {
-                bud.alive = false;
+    // On all threads, node by node: the expired lateral buds die, and a node left with a living
+    // bud gets the light exposure of its buds (each node is its own: any thread count gives the
+    // same values).
+    nodes
+        .par_iter_mut()
+        .with_min_len(PARALLEL_NODES)
+        .for_each(|node| {
+            let expired_before = node.born_iteration < expired;
+            if !expired_before
+                && cutoff.is_some_and(|c| node.born_iteration < c)
+                && node.lateral_buds.iter().any(|b| b.alive)
+            {
+                for bud in &mut node.lateral_buds {
+                    bud.alive = false;
+                }
             }
-        }
+            let has_bud = node.terminal_bud.as_ref().is_some_and(|b| b.alive)
+                || (!expired_before && node.lateral_buds.iter().any(|b| b.alive));
+            if has_bud {
+                node.light_exposure = super::light::exposure(species, shadow, node.end);
+            }
+        });
+    for (i, node) in nodes.iter().enumerate() {
+        let expired_before = node.born_iteration < expired;
         let first = scratch.buds.len();
         scratch.node_bud_start.push(first as u32);
         scratch.node_end.push(node.end);
@@ -124,8 +143,7 @@ pub(crate) fn collect(tree: &mut Tree, scratch: &mut Scratch) {
             }
         }
         if scratch.buds.len() > first {
-            let light = super::light::exposure(species, shadow, node.end);
-            node.light_exposure = light;
+            let light = node.light_exposure;
             // A bud in full shade (L = 0) can never grow when κ > 0 (Q = b·0^κ = 0): it takes
             // no part in the competition for space ([`super::space`]).
             let lit = !light_matters || light > 0.0;

@@ -12,7 +12,7 @@
 
 use glam::Vec3;
 
-use super::{Scratch, StepOptions, Tree};
+use super::{Scratch, StepOptions, Tree, parallel};
 use crate::environment::{AttractionPoints, SceneMode, clear_with_room};
 use crate::rng::Rng;
 
@@ -100,22 +100,41 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
     scratch
         .point_grid
         .rebuild_for_gathers(&scratch.positions, perception);
-    clear_with_room(&mut scratch.point_alive, points.len());
-    scratch.point_alive.resize(points.len(), false);
     // Cell by cell of the point grid: the nodes near the cell's points are gathered once, then
     // each point tests that short list (the same distances as a radius query of the node grid).
-    for (cell, positions) in scratch.point_grid.cells() {
-        let (mut lo, mut hi) = (positions[0], positions[0]);
-        for &p in positions {
-            lo = lo.min(p);
-            hi = hi.max(p);
-        }
-        scratch
-            .node_grid
-            .gather_near(lo, hi, r, &mut scratch.candidates);
-        for (&pi, &position) in cell.iter().zip(positions) {
-            scratch.point_alive[pi as usize] = !scratch.candidates.any_within(position, r);
-        }
+    // Runs of cells go to the threads; each point's result lands in its slot.
+    scratch
+        .point_grid
+        .cell_runs(parallel::RUN_ENTRIES, &mut scratch.point_runs);
+    clear_with_room(&mut scratch.slot_alive, points.len());
+    scratch.slot_alive.resize(points.len(), false);
+    let node_grid = &scratch.node_grid;
+    parallel::for_each_cell(
+        &scratch.point_grid,
+        &scratch.point_runs,
+        &mut scratch.slot_alive,
+        &mut scratch.candidates,
+        |candidates, _, _, positions, alive| {
+            let (mut lo, mut hi) = (positions[0], positions[0]);
+            for &p in positions {
+                lo = lo.min(p);
+                hi = hi.max(p);
+            }
+            node_grid.gather_near(lo, hi, r, candidates);
+            for (alive, &position) in alive.iter_mut().zip(positions) {
+                *alive = !candidates.any_within(position, r);
+            }
+        },
+    );
+    clear_with_room(&mut scratch.point_alive, points.len());
+    scratch.point_alive.resize(points.len(), false);
+    for (&pi, &alive) in scratch
+        .point_grid
+        .entry_indices()
+        .iter()
+        .zip(&scratch.slot_alive)
+    {
+        scratch.point_alive[pi as usize] = alive;
     }
     // Perception: each surviving point feeds its closest perceiving bud. The grid holds the
     // nodes with at least one competing bud (a node's buds share its position, so one distance
@@ -168,46 +187,59 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
     // Each surviving point's winner (bud, unit vector from it to the point), found in the point
     // grid's cell order, then summed in point order (the order of the sums fixes their rounding).
     let (starts, competing) = (&scratch.competing_start, &scratch.competing_buds);
-    clear_with_room(&mut scratch.point_winner, points.len());
-    scratch.point_winner.resize(points.len(), NO_WINNER);
-    // Cell by cell of the point grid: the competing nodes near the cell's points are gathered
-    // once, then each point scans that short list.
-    for (cell, positions) in scratch.point_grid.cells() {
-        let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
-        for (&pi, &position) in cell.iter().zip(positions) {
-            if scratch.point_alive[pi as usize] {
+    clear_with_room(&mut scratch.slot_winner, points.len());
+    scratch.slot_winner.resize(points.len(), NO_WINNER);
+    let (bud_grid, slot_alive) = (&scratch.bud_grid, &scratch.slot_alive);
+    // Cell by cell of the point grid (runs of cells in parallel): the competing nodes near the
+    // cell's points are gathered once, then each point scans that short list.
+    parallel::for_each_cell(
+        &scratch.point_grid,
+        &scratch.point_runs,
+        &mut scratch.slot_winner,
+        &mut scratch.candidates,
+        |candidates, first, _, positions, winners| {
+            let alive = &slot_alive[first..first + positions.len()];
+            let (mut lo, mut hi) = (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY));
+            for (&position, _) in positions.iter().zip(alive).filter(|(_, a)| **a) {
                 lo = lo.min(position);
                 hi = hi.max(position);
             }
-        }
-        if lo.x > hi.x {
-            continue;
-        }
-        scratch
-            .bud_grid
-            .gather_near(lo, hi, perception, &mut scratch.candidates);
-        for (&pi, &position) in cell.iter().zip(positions) {
-            if !scratch.point_alive[pi as usize] {
-                continue;
+            if lo.x > hi.x {
+                return;
             }
-            let best =
-                scratch
-                    .candidates
-                    .nearest_accepted(position, perception, |ci, node_pos, d2| {
-                        let towards = position - node_pos;
-                        let reach = cos_half * d2.sqrt();
-                        let buds = &competing
-                            [starts[ci as usize] as usize..starts[ci as usize + 1] as usize];
-                        buds.iter()
-                            .find(|(_, direction)| towards.dot(*direction) >= reach)
-                            .map(|&(bi, _)| (bi, node_pos))
-                    });
-            if let Some(((bi, node_pos), d2)) = best {
-                // The unit vector from the bud (at its node) to the point.
-                let towards = (position - node_pos) / d2.sqrt().max(1e-12);
-                scratch.point_winner[pi as usize] = (bi, towards);
+            bud_grid.gather_near(lo, hi, perception, candidates);
+            for ((&position, _), winner) in positions
+                .iter()
+                .zip(alive)
+                .zip(winners)
+                .filter(|((_, a), _)| **a)
+            {
+                let best = candidates.nearest_accepted(position, perception, |ci, node_pos, d2| {
+                    let towards = position - node_pos;
+                    let reach = cos_half * d2.sqrt();
+                    let buds =
+                        &competing[starts[ci as usize] as usize..starts[ci as usize + 1] as usize];
+                    buds.iter()
+                        .find(|(_, direction)| towards.dot(*direction) >= reach)
+                        .map(|&(bi, _)| (bi, node_pos))
+                });
+                if let Some(((bi, node_pos), d2)) = best {
+                    // The unit vector from the bud (at its node) to the point.
+                    let towards = (position - node_pos) / d2.sqrt().max(1e-12);
+                    *winner = (bi, towards);
+                }
             }
-        }
+        },
+    );
+    clear_with_room(&mut scratch.point_winner, points.len());
+    scratch.point_winner.resize(points.len(), NO_WINNER);
+    for (&pi, &winner) in scratch
+        .point_grid
+        .entry_indices()
+        .iter()
+        .zip(&scratch.slot_winner)
+    {
+        scratch.point_winner[pi as usize] = winner;
     }
     // The shoots' scans only ever look at surviving points: the grid keeps only them (same
     // cells, same order).
