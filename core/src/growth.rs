@@ -23,7 +23,7 @@ mod space;
 mod vigor;
 mod widths;
 
-pub use io::{TREE_FORMAT_VERSION, TreeFileError};
+pub use io::{TREE_FORMAT_VERSION, TreeFileError, TreeFileFormat};
 pub use widths::solve_pipe_exponent;
 
 use glam::Vec3;
