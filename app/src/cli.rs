@@ -11,13 +11,9 @@ pub struct Cli {
 
 #[derive(Subcommand, Debug)]
 pub enum Command {
-    /// One line per species preset, starting with its name.
-    Species,
-    /// Grows a tree autonomously and saves it; ends with a key=value summary line.
-    Grow(crate::cmd_grow::GrowArgs),
-    /// Plants several trees and grows them together, competing for light and space; ends with a
-    /// key=value summary line.
-    Garden(crate::cmd_garden::GardenArgs),
+    /// `species`, `grow` and `garden` (the lean `sylva` front runs them without this binary).
+    #[command(flatten)]
+    Growth(crate::cli_growth::GrowthCommand),
     /// Replays a recorded session headlessly: composited PNG frames and the final tree in --out.
     Replay(crate::cmd_app::ReplayArgs),
     /// Opens a window on a recorded sequence, a video file or `--camera N`.
@@ -32,9 +28,7 @@ pub enum Command {
 pub fn main() -> anyhow::Result<()> {
     let cli = Cli::parse();
     match cli.command {
-        Some(Command::Species) => crate::cmd_grow::species(),
-        Some(Command::Grow(args)) => crate::cmd_grow::grow(args),
-        Some(Command::Garden(args)) => crate::cmd_garden::garden(args),
+        Some(Command::Growth(command)) => crate::cli_growth::run(command),
         Some(Command::Replay(args)) => crate::cmd_app::replay_command(args),
         Some(Command::View(args)) => crate::cmd_app::view(args),
         Some(Command::Track(args)) => crate::cmd_track::track(args),

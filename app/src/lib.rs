@@ -5,6 +5,7 @@
 
 pub mod autosave;
 pub mod cli;
+pub mod cli_growth;
 pub mod cmd_app;
 pub mod cmd_garden;
 pub mod cmd_grow;
@@ -14,6 +15,7 @@ pub mod demo_script;
 pub mod desktop;
 pub mod footage;
 pub mod frame_report;
+pub mod limits;
 pub mod live;
 #[cfg(not(any(target_os = "android", target_os = "ios")))]
 pub mod live_capture;

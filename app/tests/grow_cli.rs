@@ -84,7 +84,9 @@ fn grow_gives_identical_files_for_a_seed_another_tree_for_another_and_ends_with_
             "height_m",
             "crown_width_m",
             "trunk_diameter_m",
-            "elapsed_ms"
+            "elapsed_ms",
+            "cpu_ms",
+            "threads"
         ],
         "{last}"
     );
