@@ -14,42 +14,75 @@ use sylva_core::species::Species;
 
 /// The seed the README's pictures and the foliage report grow.
 const SEED: u64 = 11;
+/// The seeds the foliage bounds must hold on: [`SEED`] and two more, so that no bound holds
+/// on one seed's skeleton only.
+const SEEDS: [u64; 3] = [SEED, 2014, 7];
 const AGES_YEARS: [f32; 2] = [15.0, 30.0];
 const CONIFERS: [&str; 1] = ["norway_spruce"];
 
-/// Crown measures of every preset at each of [`AGES_YEARS`], grown once for all tests.
-fn measures() -> &'static [(String, f32, CrownMeasures)] {
-    static MEASURES: OnceLock<Vec<(String, f32, CrownMeasures)>> = OnceLock::new();
+/// One preset's crown measures on one seed at one age.
+struct Crown {
+    name: String,
+    seed: u64,
+    age_years: f32,
+    measures: CrownMeasures,
+}
+
+impl Crown {
+    fn label(&self) -> String {
+        format!(
+            "{} (seed {}) at {} years",
+            self.name, self.seed, self.age_years
+        )
+    }
+}
+
+/// Crown measures of every preset on each of [`SEEDS`] at each of [`AGES_YEARS`], grown once
+/// for all tests.
+fn measures() -> &'static [Crown] {
+    static MEASURES: OnceLock<Vec<Crown>> = OnceLock::new();
     MEASURES.get_or_init(|| {
         let mut out = Vec::new();
         for species in Species::presets() {
-            let name = species.name.clone();
-            let mut tree = Tree::new(species, SEED);
-            for age in AGES_YEARS {
-                tree.grow_years(age - tree.age_years());
-                let m = tree_crown_measures(&tree, 0)
-                    .unwrap_or_else(|| panic!("{name} at {age} years has no leaves"));
-                out.push((name.clone(), age, m));
+            for seed in SEEDS {
+                let name = species.name.clone();
+                let mut tree = Tree::new(species.clone(), seed);
+                for age_years in AGES_YEARS {
+                    tree.grow_years(age_years - tree.age_years());
+                    let measures = tree_crown_measures(&tree, 0).unwrap_or_else(|| {
+                        panic!("{name} (seed {seed}) at {age_years} years has no leaves")
+                    });
+                    out.push(Crown {
+                        name: name.clone(),
+                        seed,
+                        age_years,
+                        measures,
+                    });
+                }
             }
         }
         out
     })
 }
 
-fn broadleaved() -> impl Iterator<Item = &'static (String, f32, CrownMeasures)> {
+fn broadleaved() -> impl Iterator<Item = &'static Crown> {
     measures()
         .iter()
-        .filter(|(name, _, _)| !CONIFERS.contains(&name.as_str()))
+        .filter(|c| !CONIFERS.contains(&c.name.as_str()))
 }
 
 #[test]
-fn every_broadleaved_preset_has_a_leaf_area_index_of_3_to_7_at_15_and_30_years() {
+fn every_broadleaved_preset_has_a_leaf_area_index_of_3_to_7_at_15_and_30_years_on_three_seeds() {
     let mut failures = Vec::new();
-    for (name, age, m) in broadleaved() {
+    for crown in broadleaved() {
+        let m = &crown.measures;
         if !(3.0..=7.0).contains(&m.leaf_area_index) {
             failures.push(format!(
-                "{name} at {age} years: LAI {:.2} ({:.1} m² of blade over {:.1} m² of crown)",
-                m.leaf_area_index, m.leaf_area_m2, m.crown_projection_m2
+                "{}: LAI {:.2} ({:.1} m² of blade over {:.1} m² of crown)",
+                crown.label(),
+                m.leaf_area_index,
+                m.leaf_area_m2,
+                m.crown_projection_m2
             ));
         }
     }
@@ -57,46 +90,55 @@ fn every_broadleaved_preset_has_a_leaf_area_index_of_3_to_7_at_15_and_30_years()
 }
 
 #[test]
-fn the_spruce_has_a_needle_area_index_of_at_least_4() {
-    for (name, age, m) in measures()
+fn the_spruce_has_a_needle_area_index_of_at_least_4_on_three_seeds() {
+    for crown in measures()
         .iter()
-        .filter(|(name, _, _)| CONIFERS.contains(&name.as_str()))
+        .filter(|c| CONIFERS.contains(&c.name.as_str()))
     {
         assert!(
-            m.leaf_area_index >= 4.0,
-            "{name} at {age} years: needle area index {:.2}",
-            m.leaf_area_index
+            crown.measures.leaf_area_index >= 4.0,
+            "{}: needle area index {:.2}",
+            crown.label(),
+            crown.measures.leaf_area_index
         );
     }
 }
 
-/// The presets among `names` whose side view is more than 35% sky, with their porosity.
-fn too_porous(names: &[&str]) -> Vec<String> {
+/// The crowns of the presets among `names` on the seeds among `seeds` whose side view is more
+/// than 35% sky, with their porosity.
+fn too_porous(names: &[&str], seeds: &[u64]) -> Vec<String> {
     broadleaved()
-        .filter(|(name, _, m)| names.contains(&name.as_str()) && m.side_porosity > 0.35)
-        .map(|(name, age, m)| {
+        .filter(|c| {
+            names.contains(&c.name.as_str())
+                && seeds.contains(&c.seed)
+                && c.measures.side_porosity > 0.35
+        })
+        .map(|c| {
             format!(
-                "{name} at {age} years: porosity {:.1}%",
-                100.0 * m.side_porosity
+                "{}: porosity {:.1}%",
+                c.label(),
+                100.0 * c.measures.side_porosity
             )
         })
         .collect()
 }
 
-/// Side-view porosity of the presets that meet it today; see the ignored test below for the
-/// whole criterion.
+/// Side-view porosity of the presets that meet it on the README's seed; see the ignored test
+/// below for the whole criterion.
 #[test]
-fn oak_maple_and_willow_crowns_are_at_most_35_percent_sky_from_the_side() {
-    let failures = too_porous(&["oak", "maple", "weeping_willow"]);
+fn oak_maple_and_willow_crowns_of_seed_11_are_at_most_35_percent_sky_from_the_side() {
+    let failures = too_porous(&["oak", "maple", "weeping_willow"], &[SEED]);
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 
 #[test]
-#[ignore = "issue #25 open: the birch's and the poplar's crowns are 38–59% sky from the side at \
-            a leaf area index within 3–7 (their skeletons bunch the twigs)"]
-fn every_broadleaved_crown_is_at_most_35_percent_sky_from_the_side() {
-    let names: Vec<&str> = broadleaved().map(|(name, _, _)| name.as_str()).collect();
-    let failures = too_porous(&names);
+#[ignore = "issue #25 open: 19 of the 30 broadleaved crowns (seeds 11, 2014, 7 at 15 and 30 \
+            years) are 35-51% sky from the side at a leaf area index within 3-7; the sky lies \
+            in the rim between the convex hull and a conical, tiered or lobed outline \
+            (skeleton form, not leaf density): see the README"]
+fn every_broadleaved_crown_is_at_most_35_percent_sky_from_the_side_on_three_seeds() {
+    let names: Vec<&str> = broadleaved().map(|c| c.name.as_str()).collect();
+    let failures = too_porous(&names, &SEEDS);
     assert!(failures.is_empty(), "{}", failures.join("\n"));
 }
 

@@ -277,6 +277,21 @@ impl Coverage {
     /// Pixels inside the convex hull of the pixels covered by `flags`, and how many of those are
     /// covered by nothing.
     pub fn hull_pixels(&self, flags: u8) -> (usize, usize) {
+        let (mut inside, mut open) = (0, 0);
+        for (y, span) in self.hull_spans(flags).into_iter().enumerate() {
+            let Some((first, last)) = span else {
+                continue;
+            };
+            let row = &self.pixels[y * self.width..][first..=last];
+            inside += row.len();
+            open += row.iter().filter(|&&p| p == 0).count();
+        }
+        (inside, open)
+    }
+
+    /// Per row, the first and last pixel inside the convex hull of the pixels covered by
+    /// `flags` (`None` for a row the hull misses); all `None` when the hull is degenerate.
+    pub fn hull_spans(&self, flags: u8) -> Vec<Option<(usize, usize)>> {
         // The hull of the covered pixels' squares is the hull of each row's outermost squares.
         let mut points = Vec::new();
         for y in 0..self.height {
@@ -294,11 +309,11 @@ impl Coverage {
             }
         }
         let hull = convex_hull(points);
+        let mut spans = vec![None; self.height];
         if hull.len() < 3 {
-            return (0, 0);
+            return spans;
         }
-        let (mut inside, mut open) = (0, 0);
-        for y in 0..self.height {
+        for (y, span) in spans.iter_mut().enumerate() {
             // The hull is convex: its pixels in a row form one span, found from the edges.
             let cy = y as f32 + 0.5;
             let (mut x_lo, mut x_hi) = (f32::INFINITY, f32::NEG_INFINITY);
@@ -316,14 +331,38 @@ impl Coverage {
             }
             let first = (x_lo - 0.5).ceil().max(0.0) as usize;
             let last = ((x_hi - 0.5).floor() as usize).min(self.width - 1);
+            if first <= last {
+                *span = Some((first, last));
+            }
+        }
+        spans
+    }
+
+    /// Background share of the convex hull of the pixels covered by `flags`, in the middle
+    /// `middle` of each row's span and in the rest (the rim at both ends): (middle, rim). A
+    /// crown dense inside but with a lobed or conical outline shows a low middle and a high rim.
+    pub fn hull_sky_middle_and_rim(&self, flags: u8, middle: f32) -> (f32, f32) {
+        let (lo, hi) = (0.5 - 0.5 * middle, 0.5 + 0.5 * middle);
+        let (mut mid, mut mid_open, mut rim, mut rim_open) = (0usize, 0usize, 0usize, 0usize);
+        for (y, span) in self.hull_spans(flags).into_iter().enumerate() {
+            let Some((first, last)) = span else {
+                continue;
+            };
+            let n = (last - first + 1) as f32;
             for x in first..=last {
-                inside += 1;
-                if self.pixels[y * self.width + x] == 0 {
-                    open += 1;
+                let t = (x - first) as f32 / n;
+                let open = usize::from(self.pixels[y * self.width + x] == 0);
+                if (lo..hi).contains(&t) {
+                    mid += 1;
+                    mid_open += open;
+                } else {
+                    rim += 1;
+                    rim_open += open;
                 }
             }
         }
-        (inside, open)
+        let share = |open: usize, all: usize| open as f32 / all.max(1) as f32;
+        (share(mid_open, mid), share(rim_open, rim))
     }
 
     /// Pixels covered by `flags` in exactly one of `self` and `other`, which must be of the
@@ -404,14 +443,19 @@ fn convex_hull(mut points: Vec<Vec2>) -> Vec<Vec2> {
 mod tests {
     use super::*;
 
+    /// An empty coverage of `width` × `height` pixels of `pixel_size_m`.
+    fn empty(width: usize, height: usize, pixel_size_m: f32) -> Coverage {
+        Coverage {
+            width,
+            height,
+            pixel_size_m,
+            pixels: vec![0; width * height],
+        }
+    }
+
     #[test]
     fn the_hull_of_a_filled_square_is_the_square_with_no_open_pixels() {
-        let mut coverage = Coverage {
-            width: 20,
-            height: 20,
-            pixel_size_m: 0.1,
-            pixels: vec![0; 400],
-        };
+        let mut coverage = empty(20, 20, 0.1);
         for y in 5..15 {
             for x in 5..15 {
                 coverage.pixels[y * 20 + x] = LEAF;
@@ -425,12 +469,7 @@ mod tests {
 
     #[test]
     fn the_hull_of_three_corner_pixels_spans_the_triangle_between_them() {
-        let mut coverage = Coverage {
-            width: 10,
-            height: 10,
-            pixel_size_m: 1.0,
-            pixels: vec![0; 100],
-        };
+        let mut coverage = empty(10, 10, 1.0);
         coverage.pixels[0] = LEAF;
         coverage.pixels[9 * 10 + 9] = LEAF;
         coverage.pixels[9 * 10] = LEAF;
@@ -438,5 +477,20 @@ mod tests {
         // The hull of the three corner squares: row y holds min(y + 2, 10) pixel centres.
         assert_eq!(inside, 64);
         assert_eq!(open, 61);
+    }
+
+    #[test]
+    fn a_crown_full_in_the_middle_with_an_empty_rim_shows_sky_only_in_the_rim() {
+        // A square hull (leaves on its left and right edges) filled in its middle 40% only.
+        let mut coverage = empty(20, 20, 0.1);
+        for y in 0..20 {
+            for x in [0, 19].into_iter().chain(6..14) {
+                coverage.pixels[y * 20 + x] = LEAF;
+            }
+        }
+        let (middle, rim) = coverage.hull_sky_middle_and_rim(LEAF, 0.4);
+        assert_eq!(middle, 0.0);
+        assert!((rim - 10.0 / 12.0).abs() < 1e-6, "rim {rim}");
+        assert_eq!(coverage.hull_pixels(LEAF), (400, 200));
     }
 }

@@ -182,6 +182,9 @@ pub struct Looks {
     pub leaves_per_metre: f32,
     /// Leaves on branches thinner than this many tip diameters (`tip_diameter_m`).
     pub leafy_diameters: f32,
+    /// Angle between a leaf-bearing branch and its leaves' petioles (or a spray card's axis),
+    /// degrees; `None` for the generic 52° (0.9 rad).
+    pub leaf_insertion_deg: Option<f32>,
     /// Leaves drawn on one card (a spray of small leaves, a needle shoot; see
     /// [`super::leaf_card`]).
     pub leaves_per_card: u32,
@@ -201,6 +204,7 @@ impl Default for Looks {
             leaf_width: 0.06,
             leaves_per_metre: 120.0,
             leafy_diameters: 10.0,
+            leaf_insertion_deg: None,
             leaves_per_card: 8,
             evergreen: false,
             leaf_color: SeasonColors::default(),
@@ -234,6 +238,9 @@ impl Looks {
         ];
         if let Some(fruit) = &self.fruit {
             numbers.push(("looks.fruit.radius_m", fruit.radius_m, 0.001, 0.5));
+        }
+        if let Some(angle) = self.leaf_insertion_deg {
+            numbers.push(("looks.leaf_insertion_deg", angle, 0.0, 180.0));
         }
         for (name, v, lo, hi) in numbers {
             if !(v.is_finite() && (lo..=hi).contains(&v)) {
@@ -311,6 +318,9 @@ pub fn mesh_params_in(species: &Species, season: Season) -> MeshParams {
             width: look.leaf_width,
             leaves_per_card: look.leaves_per_card,
             petiole_length: 0.3 * look.leaf_length,
+            insertion_angle: look
+                .leaf_insertion_deg
+                .map_or(LeafParams::default().insertion_angle, f32::to_radians),
             ..LeafParams::default()
         },
         fruit: fruit.map(|f| FruitParams {
@@ -457,8 +467,11 @@ mod tests {
     #[test]
     fn bad_look_values_are_refused_naming_the_field() {
         type Damage = fn(&mut Looks);
-        let cases: [(&str, Damage); 5] = [
+        let cases: [(&str, Damage); 6] = [
             ("looks.leaf_length", |l| l.leaf_length = f32::NAN),
+            ("looks.leaf_insertion_deg", |l| {
+                l.leaf_insertion_deg = Some(200.0)
+            }),
             ("looks.leaves_per_metre", |l| l.leaves_per_metre = -1.0),
             ("looks.leafy_diameters", |l| l.leafy_diameters = 0.5),
             ("looks.leaf_color.autumn", |l| l.leaf_color.autumn[0] = 3.0),
@@ -490,5 +503,17 @@ mod tests {
         assert_eq!(looks.leaf_length, Looks::default().leaf_length);
         let err = serde_json::from_str::<Looks>(r#"{"leaf_shap": "palmate"}"#).unwrap_err();
         assert!(err.to_string().contains("leaf_shap"), "{err}");
+    }
+
+    #[test]
+    fn a_stated_leaf_insertion_angle_reaches_the_leaves_and_none_keeps_the_generic_one() {
+        let mut species = Species::by_name("oak").expect("a preset");
+        let generic = mesh_params_for(&species).leaves.insertion_angle;
+        assert_eq!(generic, LeafParams::default().insertion_angle);
+        let mut looks = species.looks().clone();
+        looks.leaf_insertion_deg = Some(15.0);
+        species.looks = Some(looks);
+        let stated = mesh_params_for(&species).leaves.insertion_angle;
+        assert!((stated - 15f32.to_radians()).abs() < 1e-6, "{stated}");
     }
 }
