@@ -19,7 +19,9 @@ struct HullScene<'a> {
     hull: &'a Hull,
     world_from_tree: Affine3A,
     height_m: f32,
-    /// The trunk's free column around the axis (m), from the ground up.
+    /// The trunk's free column around the axis (m), from the ground up (the crown's narrow
+    /// bottom, eroded away, must not stop the trunk; crown lifting keeps all else below the
+    /// crown base out of it).
     trunk_column_m: f32,
 }
 
@@ -176,11 +178,13 @@ impl FillGrid {
     }
 }
 
-/// Crown lifting, as the real tree has it: below the crown base the trunk keeps one axis. From
-/// the base up, the trunk continues into the child carrying the most internodes (a lateral that
-/// took over the lead is the trunk then); its other children below the crown base are removed.
-/// Returns how many internodes went.
-pub fn lift_crown(tree: &mut Tree, crown_base_m: f32) -> usize {
+/// Crown lifting, as the real tree has it: below the crown base the trunk keeps one axis, bare.
+/// From the base up, the trunk continues into the child carrying the most internodes (a lateral
+/// that took over the lead is the trunk then); every other internode that ends below
+/// `crown_base_m + leaf_reach_m` is cut with what it carries: the trunk's low branches, and
+/// shoots of the crown that hang below its base (the leaves they would carry sit below the
+/// lowest foliage). Returns how many internodes went.
+pub fn lift_crown(tree: &mut Tree, crown_base_m: f32, leaf_reach_m: f32) -> usize {
     let nodes = &tree.skeleton.internodes;
     if nodes.is_empty() {
         return 0;
@@ -192,17 +196,30 @@ pub fn lift_crown(tree: &mut Tree, crown_base_m: f32) -> usize {
             size[parent.index()] += size[i];
         }
     }
-    let mut roots = Vec::new();
+    let lowest_foliage_m = crown_base_m + leaf_reach_m;
+    let mut trunk = vec![false; nodes.len()];
     let mut node = sylva_core::NodeId(0);
-    while nodes[node.index()].end.y < crown_base_m {
-        let Some(trunk) = nodes[node.index()]
+    trunk[0] = true;
+    while nodes[node.index()].end.y < lowest_foliage_m {
+        let Some(next) = nodes[node.index()]
             .children()
             .max_by_key(|c| size[c.index()])
         else {
             break;
         };
-        roots.extend(nodes[node.index()].children().filter(|&c| c != trunk));
-        node = trunk;
+        trunk[next.index()] = true;
+        node = next;
+    }
+    let mut cut = vec![false; nodes.len()];
+    let mut roots = Vec::new();
+    for (i, n) in nodes.iter().enumerate() {
+        let parent_cut = n.parent.is_some_and(|p| cut[p.index()]);
+        if parent_cut {
+            cut[i] = true;
+        } else if !trunk[i] && n.end.y < lowest_foliage_m {
+            cut[i] = true;
+            roots.push(sylva_core::NodeId(i as u32));
+        }
     }
     if roots.is_empty() {
         0
@@ -278,7 +295,7 @@ pub fn grow_into_hull(
             autonomous: true,
             scene: Some((&scene, SceneMode::GrowInFront)),
         });
-        lift_crown(&mut tree, crown_base_m);
+        lift_crown(&mut tree, crown_base_m, LEAF_REACH_M as f32);
         filled = grid.filled(&tree, reach_m);
         history.push(filled);
         if best.as_ref().is_none_or(|(f, _)| filled > *f) {
@@ -317,19 +334,24 @@ mod tests {
         let mut tree = Tree::new(species, 3);
         tree.grow_years(6.0);
         let before = tree.skeleton.len();
-        let removed = lift_crown(&mut tree, 1.0);
+        let removed = lift_crown(&mut tree, 1.0, 0.1);
         assert!(removed > 0 && tree.skeleton.len() == before - removed);
         let low: Vec<_> = tree
             .skeleton
             .internodes
             .iter()
-            .filter(|n| n.end.y < 1.0)
+            .filter(|n| n.end.y < 1.1)
             .collect();
+        // Only the trunk's single axis ends below the crown base and the leaves' reach.
+        let chain_ok = low
+            .iter()
+            .all(|n| n.parent.is_none_or(|p| tree.skeleton.get(p).end.y < 1.1));
+        assert!(chain_ok, "a shoot hangs below the crown base");
         let branching = low
             .iter()
             .filter(|n| {
                 n.children()
-                    .filter(|c| tree.skeleton.get(*c).end.y < 1.0)
+                    .filter(|c| tree.skeleton.get(*c).end.y < 1.1)
                     .count()
                     > 1
             })
