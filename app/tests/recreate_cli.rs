@@ -188,6 +188,7 @@ fn tree_a_from_three_outlines_measures_height_width_and_crown_base_and_regrows_a
     println!(
         "tree_a: IoU against the true masks: marked views {marked:.3}, unmarked {unmarked:.3}"
     );
+    check_iou("tree_a", marked, unmarked);
     prune_a_main_limb_and_grow_ten_years(&dir.join("tree.json"));
 }
 
@@ -261,6 +262,20 @@ fn tree_b_in_front_of_a_wall_from_two_outlines_measures_height_width_and_crown_b
     let unmarked = mean_iou(&run, &footage, &[60, 90, 120]);
     println!(
         "tree_b: IoU against the true masks: marked views {marked:.3}, unmarked {unmarked:.3}"
+    );
+    check_iou("tree_b", marked, unmarked);
+}
+
+/// The targets are IoU 0.80 in the marked views and 0.70 in the others; the model (leaf
+/// cards alpha-tested, as drawn) reaches about 0.42-0.45 today, its crown sparser than the
+/// real one. Until the targets hold this guards what holds: a floor a little under today's.
+const MIN_IOU_MARKED: f64 = 0.38;
+const MIN_IOU_UNMARKED: f64 = 0.38;
+
+fn check_iou(name: &str, marked: f64, unmarked: f64) {
+    assert!(
+        marked >= MIN_IOU_MARKED && unmarked >= MIN_IOU_UNMARKED,
+        "{name}: IoU with the true masks {marked:.3} in the marked views (floor {MIN_IOU_MARKED}), {unmarked:.3} in the others (floor {MIN_IOU_UNMARKED})"
     );
 }
 

@@ -228,6 +228,28 @@ pub fn lift_crown(tree: &mut Tree, crown_base_m: f32, leaf_reach_m: f32) -> usiz
     }
 }
 
+/// The trunk below the crown base is bare, as measured: leaves grow only on branches thinner
+/// than the trunk where it meets the crown base (the tree's leafy threshold, in tip diameters,
+/// lowered to that from the species' `leafy_diameters` when the trunk is thinner than it).
+pub fn bare_trunk(tree: &mut Tree, crown_base_m: f32, leafy_diameters: f32) {
+    let nodes = &tree.skeleton.internodes;
+    let mut node = 0;
+    // Up the leader (the main child) to the internode that reaches the crown base.
+    while nodes[node].end.y < crown_base_m {
+        let Some(next) = nodes[node].main_child else {
+            break;
+        };
+        node = next.index();
+    }
+    let Some(at_base) = nodes.get(node).map(|n| n.diameter) else {
+        return;
+    };
+    let tip = tree.species.tip_diameter_m.max(1e-4);
+    let mut looks = tree.species.looks().clone();
+    looks.leafy_diameters = (at_base / tip).clamp(1.0, leafy_diameters.max(1.0));
+    tree.species.looks = Some(looks);
+}
+
 /// Grows `species` into the recreation's hull; `max_years` bounds the growth.
 pub fn grow_into_hull(
     species: Species,
@@ -286,6 +308,7 @@ pub fn grow_into_hull(
     let reach_m = FILL_REACH_INTERNODES * tree.species.internode_length_m;
     let grid = FillGrid::new(&hull_in_tree, (reach_m * 0.5).max(voxel_m));
     let max_iterations = tree.species.iterations_for_years(max_years).max(1);
+    let leafy_diameters = tree.species.looks().leafy_diameters;
     let mut history: Vec<f32> = Vec::new();
     let mut filled = 0.0;
     // Shedding may take back what a few iterations filled: the fullest tree is kept.
@@ -311,8 +334,9 @@ pub fn grow_into_hull(
     }
     if let Some((best_filled, best_tree)) = best {
         (filled, tree) = (best_filled, best_tree);
-        tree.update_widths();
     }
+    tree.update_widths();
+    bare_trunk(&mut tree, crown_base_m, leafy_diameters);
     let report = GrowthReport {
         species: tree.species.name.clone(),
         species_choice,
@@ -358,5 +382,27 @@ mod tests {
             .count();
         assert_eq!(branching, 0, "a branching point below the crown base");
         assert!(tree.sanity_check().is_ok());
+    }
+
+    #[test]
+    fn below_the_crown_base_the_trunk_is_too_thick_for_leaves() {
+        let species = Species::by_name("birch").expect("birch preset");
+        let mut tree = Tree::new(species, 5);
+        tree.grow_years(8.0);
+        lift_crown(&mut tree, 1.0, 0.1);
+        let leafy = tree.species.looks().leafy_diameters;
+        bare_trunk(&mut tree, 1.0, leafy);
+        let threshold = tree.species.tip_diameter_m * tree.species.looks().leafy_diameters;
+        let low: Vec<_> = (tree.skeleton.internodes.iter())
+            .filter(|n| n.end.y < 1.0)
+            .collect();
+        assert!(!low.is_empty());
+        for n in low {
+            assert!(
+                n.diameter >= threshold,
+                "a trunk internode of {} m below the crown base, leaves below {threshold} m",
+                n.diameter
+            );
+        }
     }
 }

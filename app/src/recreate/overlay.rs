@@ -34,33 +34,34 @@ pub fn overlay_layer(
     let seen = Silhouette::render(footage, frame, model);
     let (width, height) = (seen.width, seen.height);
     let mut layer = RgbaImage::new(width, height);
-    let at = |x: i64, y: i64| {
+    let solid = outer_shape(&seen);
+    let w = width as usize;
+    let is_solid = |x: i64, y: i64| {
         x >= 0
             && y >= 0
             && x < i64::from(width)
             && y < i64::from(height)
-            && seen.inside[(y as u32 * width + x as u32) as usize]
+            && solid[y as usize * w + x as usize]
     };
     let fill_alpha = (style.opacity.clamp(0.0, 1.0) * 255.0).round() as u8;
     for y in 0..i64::from(height) {
         for x in 0..i64::from(width) {
-            if !at(x, y) {
-                continue;
-            }
-            let edge = !(at(x - 1, y) && at(x + 1, y) && at(x, y - 1) && at(x, y + 1));
+            let i = y as usize * w + x as usize;
+            let edge = solid[i]
+                && !(is_solid(x - 1, y)
+                    && is_solid(x + 1, y)
+                    && is_solid(x, y - 1)
+                    && is_solid(x, y + 1));
             let alpha = if edge {
                 255
-            } else if style.outline_only {
-                0
-            } else {
+            } else if !style.outline_only && seen.inside[i] {
                 fill_alpha
+            } else {
+                0
             };
             if alpha > 0 {
-                layer.put_pixel(
-                    x as u32,
-                    y as u32,
-                    Rgba([MODEL[0], MODEL[1], MODEL[2], alpha]),
-                );
+                let [r, g, b] = MODEL;
+                layer.put_pixel(x as u32, y as u32, Rgba([r, g, b, alpha]));
             }
         }
     }
@@ -72,6 +73,51 @@ pub fn overlay_layer(
         }
     }
     layer
+}
+
+/// Gaps between leaves narrower than this close in the outer shape, pixels.
+const GAP_PX: i64 = 2;
+
+/// The silhouette's outer shape: what the background, flooded in from the image's border, does
+/// not reach once the silhouette is dilated by [`GAP_PX`] (the gaps between leaves closed, so
+/// the outline follows the crown, not every leaf).
+fn outer_shape(seen: &Silhouette) -> Vec<bool> {
+    let (w, h) = (seen.width as i64, seen.height as i64);
+    let mut blocked = vec![false; (w * h) as usize];
+    for y in 0..h {
+        for x in 0..w {
+            if !seen.inside[(y * w + x) as usize] {
+                continue;
+            }
+            for yy in (y - GAP_PX).max(0)..=(y + GAP_PX).min(h - 1) {
+                for xx in (x - GAP_PX).max(0)..=(x + GAP_PX).min(w - 1) {
+                    blocked[(yy * w + xx) as usize] = true;
+                }
+            }
+        }
+    }
+    let mut background = vec![false; blocked.len()];
+    let mut stack: Vec<(i64, i64)> = Vec::new();
+    for x in 0..w {
+        stack.push((x, 0));
+        stack.push((x, h - 1));
+    }
+    for y in 0..h {
+        stack.push((0, y));
+        stack.push((w - 1, y));
+    }
+    while let Some((x, y)) = stack.pop() {
+        if x < 0 || y < 0 || x >= w || y >= h {
+            continue;
+        }
+        let i = (y * w + x) as usize;
+        if background[i] || blocked[i] {
+            continue;
+        }
+        background[i] = true;
+        stack.extend([(x - 1, y), (x + 1, y), (x, y - 1), (x, y + 1)]);
+    }
+    background.iter().map(|b| !b).collect()
 }
 
 /// A two-pixel-wide line from `a` to `b`, opaque.

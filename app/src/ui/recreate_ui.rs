@@ -122,7 +122,51 @@ pub fn recreate_ui(
     }
 }
 
-/// The traced outlines of the frame shown and the trunk-base tap, over the view.
+/// The overlay's texture, kept while the tree, the frame and the style stay the same.
+#[derive(Clone)]
+struct OverlayTexture {
+    key: (u64, usize, u32, bool),
+    texture: egui::TextureHandle,
+}
+
+/// After "Grow to fit": the model over the real tree in the frame shown, filled at the chosen
+/// opacity or as its outline only ([`DesignState::recreate_overlay`]); re-drawn when the tree,
+/// the frame or the style changes.
+fn model_overlay_ui(ui: &Ui, design: &DesignState, painter: &egui::Painter, corners: [egui::Pos2; 2]) {
+    let mode = &design.recreate;
+    let (Some(_), Some(step)) = (&mode.result, mode.frame_step()) else {
+        return;
+    };
+    let style = mode.overlay;
+    let key = (design.revision, step, style.opacity.to_bits(), style.outline_only);
+    let id = egui::Id::new("recreate overlay texture");
+    let cached: Option<OverlayTexture> = ui.ctx().data_mut(|d| d.get_temp(id));
+    let texture = match cached {
+        Some(c) if c.key == key => c.texture,
+        _ => {
+            let Some(layer) = design.recreate_overlay(Some(step), style) else {
+                return;
+            };
+            let size = [layer.width() as usize, layer.height() as usize];
+            let image = egui::ColorImage::from_rgba_unmultiplied(size, layer.as_raw());
+            let texture = ui
+                .ctx()
+                .load_texture("recreate overlay", image, egui::TextureOptions::NEAREST);
+            let entry = OverlayTexture {
+                key,
+                texture: texture.clone(),
+            };
+            ui.ctx().data_mut(|d| d.insert_temp(id, entry));
+            texture
+        }
+    };
+    let uv = egui::Rect::from_min_max(egui::pos2(0.0, 0.0), egui::pos2(1.0, 1.0));
+    let rect = egui::Rect::from_min_max(corners[0], corners[1]);
+    painter.image(texture.id(), rect, uv, Color32::WHITE);
+}
+
+/// The model overlay, the traced outlines of the frame shown and the trunk-base tap, over the
+/// view.
 pub fn recreate_overlay_ui(ui: &Ui, design: &DesignState, view: egui::Rect) {
     let mode = &design.recreate;
     let (Some(camera), Some(step)) = (design.world_camera(), mode.frame_step()) else {
@@ -143,6 +187,12 @@ pub fn recreate_overlay_ui(ui: &Ui, design: &DesignState, view: egui::Rect) {
             &camera.intrinsics,
         )
     };
+    let k = &camera.intrinsics;
+    let corners = [
+        to_window(&[0.0, 0.0]),
+        to_window(&[f64::from(k.width), f64::from(k.height)]),
+    ];
+    model_overlay_ui(ui, design, &painter, corners);
     for outline in mode.outlines.iter().filter(|o| o.frame == step) {
         let mut points: Vec<egui::Pos2> = outline.outline.iter().map(to_window).collect();
         if let Some(first) = points.first().copied() {
