@@ -103,20 +103,6 @@ impl Default for RecreateMode {
     }
 }
 
-/// The tracker's camera for the app's intrinsics.
-fn camera_of(intrinsics: &Intrinsics) -> Camera {
-    let mut camera = Camera::pinhole(
-        intrinsics.width,
-        intrinsics.height,
-        f64::from(intrinsics.fx),
-        f64::from(intrinsics.fy),
-        f64::from(intrinsics.cx),
-        f64::from(intrinsics.cy),
-    );
-    camera.distortion = intrinsics.distortion.map(f64::from);
-    camera
-}
-
 fn pose_of(world_from_camera: Mat4) -> DAffine3 {
     let m = world_from_camera.as_dmat4();
     DAffine3 {
@@ -138,7 +124,8 @@ impl RecreateMode {
         ground: Option<GroundPlane>,
         observations: &[Observation],
     ) {
-        self.camera.get_or_insert_with(|| camera_of(intrinsics));
+        self.camera
+            .get_or_insert_with(|| crate::scale::camera_of(intrinsics));
         if let Some(g) = ground {
             let normal = g.normal.as_dvec3().normalize_or(DVec3::Y);
             self.ground = Some(Plane {

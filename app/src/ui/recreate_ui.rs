@@ -132,14 +132,24 @@ struct OverlayTexture {
 /// After "Grow to fit": the model over the real tree in the frame shown, filled at the chosen
 /// opacity or as its outline only ([`DesignState::recreate_overlay`]); re-drawn when the tree,
 /// the frame or the style changes.
-fn model_overlay_ui(ui: &Ui, design: &DesignState, painter: &egui::Painter, corners: [egui::Pos2; 2]) {
+fn model_overlay_ui(
+    ui: &Ui,
+    design: &DesignState,
+    painter: &egui::Painter,
+    corners: [egui::Pos2; 2],
+) {
     let mode = &design.recreate;
     let (Some(_), Some(step)) = (&mode.result, mode.frame_step()) else {
         return;
     };
     let style = mode.overlay;
-    let key = (design.revision, step, style.opacity.to_bits(), style.outline_only);
-    let id = egui::Id::new("recreate overlay texture");
+    let key = (
+        design.revision,
+        step,
+        style.opacity.to_bits(),
+        style.outline_only,
+    );
+    let id = egui::Id::unique("recreate overlay texture");
     let cached: Option<OverlayTexture> = ui.ctx().data_mut(|d| d.get_temp(id));
     let texture = match cached {
         Some(c) if c.key == key => c.texture,
@@ -149,9 +159,9 @@ fn model_overlay_ui(ui: &Ui, design: &DesignState, painter: &egui::Painter, corn
             };
             let size = [layer.width() as usize, layer.height() as usize];
             let image = egui::ColorImage::from_rgba_unmultiplied(size, layer.as_raw());
-            let texture = ui
-                .ctx()
-                .load_texture("recreate overlay", image, egui::TextureOptions::NEAREST);
+            let texture =
+                ui.ctx()
+                    .load_texture("recreate overlay", image, egui::TextureOptions::NEAREST);
             let entry = OverlayTexture {
                 key,
                 texture: texture.clone(),
