@@ -25,7 +25,7 @@ pub fn recreate_ui(
 ) {
     let mode = &design.recreate;
     ui.horizontal_wrapped(|ui| {
-        if ui.button("Recreate a tree").clicked() {
+        if ui.button("Start marking").clicked() {
             send(events, RecreateAction::Start);
         }
         if mode.active && ui.button("Stop marking").clicked() {
@@ -43,10 +43,9 @@ pub fn recreate_ui(
         ui.label(step);
     }
     ui.horizontal_wrapped(|ui| {
-        ui.label("Species:");
         let chosen = mode.species.clone();
         let text = chosen.clone().unwrap_or_else(|| "closest by shape".into());
-        egui::ComboBox::from_id_salt("recreate species")
+        egui::ComboBox::from_label("Species to grow")
             .selected_text(text)
             .show_ui(ui, |ui| {
                 if ui
