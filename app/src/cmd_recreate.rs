@@ -12,9 +12,9 @@ use glam::DAffine3;
 use serde::Serialize;
 
 use crate::recreate::footage::track_footage;
-use crate::recreate::grow::{GrowthReport, closest_species, grow_into_hull};
+use crate::recreate::grow::GrowthReport;
 use crate::recreate::marks::Marks;
-use crate::recreate::measure::{Measurements, measure};
+use crate::recreate::measure::Measurements;
 use crate::recreate::silhouette::{Silhouette, WorldTriangles};
 
 #[derive(clap::Args, Debug)]
@@ -123,39 +123,18 @@ pub fn recreate(args: RecreateArgs) -> anyhow::Result<()> {
     drop(sequence);
     let footage = track_footage(&args.footage, args.holding_height_m)
         .with_context(|| format!("tracking {}", args.footage.display()))?;
-    let recreation = measure(&footage, &marks)
+    let recreated = crate::recreate::recreate(&footage, &marks, species, args.seed, args.max_years)
         .with_context(|| format!("bad marks in {}", args.marks.display()))?;
-    let m = &recreation.measurements;
-    let (species, choice) = match species {
-        Some(s) => (s, "given (--species)".to_owned()),
-        None => closest_species(m.height_m, m.crown_width_m),
-    };
-    let (tree, world_from_tree, growth) = grow_into_hull(
-        species,
-        choice,
-        args.seed,
-        &recreation,
-        footage.ground.normal,
-        args.max_years,
-    );
+    let (tree, world_from_tree) = (&recreated.tree, recreated.world_from_tree);
+    let (m, growth) = (&recreated.recreation.measurements, &recreated.growth);
     tree.save(&args.out)?;
-    let mut meshes =
-        sylva_core::geometry::build_tree_meshes_in(&tree, sylva_core::geometry::Season::Summer);
-    crate::recreate::place_meshes(&mut meshes, &world_from_tree);
+    let meshes = recreated.world_meshes();
     if let Some(path) = &args.glb {
         sylva_core::export::write_glb(&meshes, path)?;
     }
     let model = WorldTriangles::of_meshes(&meshes, &glam::Affine3A::IDENTITY);
-    let outline_iou: Vec<(usize, f64)> = recreation
-        .masks
-        .iter()
-        .map(|mask| {
-            let silhouette = Silhouette::render(&footage, mask.frame, &model);
-            (mask.frame, silhouette.iou_with_outline(mask))
-        })
-        .collect();
-    let iou_mean =
-        outline_iou.iter().map(|(_, v)| v).sum::<f64>() / outline_iou.len().max(1) as f64;
+    let outline_iou = recreated.outline_iou.clone();
+    let iou_mean = recreated.outline_iou_mean();
     if let Some(dir) = &args.silhouettes {
         std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
         for (frame, pose) in footage.world_from_camera.iter().enumerate() {
@@ -177,7 +156,7 @@ pub fn recreate(args: RecreateArgs) -> anyhow::Result<()> {
         let report = Report {
             footage: args.footage.display().to_string(),
             measurements: m,
-            growth: &growth,
+            growth,
             outline_iou: outline_iou.clone(),
             outline_iou_mean: iou_mean,
             internodes,

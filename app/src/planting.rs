@@ -185,6 +185,8 @@ impl DesignState {
         self.occupancy
             .get_or_insert_with(|| SceneOccupancy::new(intrinsics))
             .observe(observations, world_from_camera, ground.is_some());
+        self.recreate
+            .observe(intrinsics, world_from_camera, ground, observations);
     }
 
     /// Builds the scene's occupancy on a worker thread (the window; replays build the same map

@@ -389,7 +389,7 @@ impl DesignScale {
 }
 
 /// The tracking camera of the footage's intrinsics (the pixels the touches are in).
-fn camera_of(k: &Intrinsics) -> Camera {
+pub(crate) fn camera_of(k: &Intrinsics) -> Camera {
     Camera {
         distortion: k.distortion.map(f64::from),
         ..Camera::pinhole(

@@ -228,6 +228,9 @@ impl Session {
                     Some(format!("a known length of {length_m} m"))
                 }
                 InputEvent::Tool { tool } if tool.check().is_err() => tool.check().err(),
+                InputEvent::Recreate {
+                    action: crate::state::RecreateAction::Overlay { opacity, .. },
+                } if !opacity.is_finite() => Some(format!("an overlay opacity of {opacity}")),
                 _ if !timed.time_s.is_finite() => Some("a non-finite time".into()),
                 _ => None,
             };

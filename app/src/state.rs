@@ -29,7 +29,9 @@ use crate::render::{GroundPlane, ViewCamera};
 use crate::scale::{DesignScale, ScaleTool};
 use crate::scene_tracking::SceneOccupancy;
 
+mod recreate;
 mod tools;
+pub use recreate::{RecreateAction, RecreateMode, RecreateResult};
 pub use tools::{DEFAULT_BRANCH_DIAMETER_M, LASSO_MAX_ITERATIONS, Tool};
 
 /// Growth and brush parameters the UI exposes.
@@ -239,6 +241,11 @@ pub enum InputEvent {
         tree_file: String,
         world_from_tree: Option<[f32; 12]>,
     },
+    /// The Recreate mode's controls ([`RecreateAction`]): start marking a real tree, pick the
+    /// species, grow to fit, the overlay.
+    Recreate {
+        action: RecreateAction,
+    },
 }
 
 /// A brush stroke.
@@ -315,6 +322,8 @@ pub struct DesignState {
     grow_debt: f32,
     /// The editing tool and its gesture in progress.
     tools: tools::ToolState,
+    /// Recreating a real tree: its marks, what was observed for them, the last result.
+    pub recreate: RecreateMode,
 }
 
 /// Grows `tree` autonomously to iteration `target` (keeping each iteration in `timeline`) against
@@ -410,6 +419,7 @@ impl DesignState {
             revision: 0,
             grow_debt: 0.0,
             tools: Default::default(),
+            recreate: RecreateMode::default(),
         }
     }
 
@@ -507,6 +517,7 @@ impl DesignState {
                     self.restore_tree(tree, *world_from_tree);
                 }
             }
+            InputEvent::Recreate { action } => self.recreate_action(action),
         }
     }
 
@@ -645,6 +656,9 @@ impl DesignState {
         if self.scale.tool.is_some() {
             // A scale tool takes the taps (its touches never reach the tree).
             self.scale.touch(phase, id, pixel);
+            return;
+        }
+        if self.recreate_touch(phase, id, pixel) {
             return;
         }
         if self.tool_touch(phase, id, pixel) {

@@ -10,6 +10,9 @@ use std::process::{Command, Output};
 
 use serde_json::Value;
 
+mod recreate_marks;
+use recreate_marks::{base_tap, mask, traced_outline};
+
 fn data(name: &str) -> PathBuf {
     PathBuf::from(env!("CARGO_MANIFEST_DIR"))
         .join("../test-data")
@@ -29,129 +32,6 @@ fn text(output: &Output) -> String {
         String::from_utf8_lossy(&output.stdout),
         String::from_utf8_lossy(&output.stderr)
     )
-}
-
-/// A grey mask of frame `index` (255 foliage, 128 wood, 0 not the tree).
-struct Mask {
-    width: usize,
-    height: usize,
-    pixels: Vec<u8>,
-}
-
-fn mask(footage: &Path, index: usize) -> Mask {
-    let list = std::fs::read_to_string(footage.join("masks.txt")).expect("masks.txt");
-    let file = list
-        .lines()
-        .filter(|l| !l.starts_with('#'))
-        .nth(index)
-        .and_then(|l| l.split_whitespace().nth(1))
-        .expect("a mask for the frame");
-    let image = image::open(footage.join(file))
-        .expect("mask png")
-        .to_luma8();
-    Mask {
-        width: image.width() as usize,
-        height: image.height() as usize,
-        pixels: image.into_raw(),
-    }
-}
-
-/// Small deterministic jitter in [0, 1).
-fn jitter(i: usize, salt: u64) -> f64 {
-    let mut z = (i as u64).wrapping_mul(0x9e37_79b9_7f4a_7c15) ^ salt;
-    z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-    z ^= z >> 31;
-    (z >> 11) as f64 / (1u64 << 53) as f64
-}
-
-/// Convex hull (monotone chain) of integer points, counter-clockwise.
-fn convex_hull(mut points: Vec<(f64, f64)>) -> Vec<(f64, f64)> {
-    points.sort_by(|a, b| a.partial_cmp(b).expect("finite"));
-    points.dedup();
-    let cross = |o: (f64, f64), a: (f64, f64), b: (f64, f64)| {
-        (a.0 - o.0) * (b.1 - o.1) - (a.1 - o.1) * (b.0 - o.0)
-    };
-    let mut hull: Vec<(f64, f64)> = Vec::new();
-    for pass in 0..2 {
-        let start = hull.len();
-        let iter: Box<dyn Iterator<Item = &(f64, f64)>> = if pass == 0 {
-            Box::new(points.iter())
-        } else {
-            Box::new(points.iter().rev())
-        };
-        for &p in iter {
-            while hull.len() >= start + 2
-                && cross(hull[hull.len() - 2], hull[hull.len() - 1], p) <= 0.0
-            {
-                hull.pop();
-            }
-            hull.push(p);
-        }
-        hull.pop();
-    }
-    hull
-}
-
-/// The crown as a user traces it: the foliage's outer boundary, walked at 24 evenly spaced
-/// points, each pushed 2–3.5 px outwards from the crown's centre.
-fn traced_outline(mask: &Mask, salt: u64) -> Vec<[f64; 2]> {
-    let mut corners = Vec::new();
-    for y in 0..mask.height {
-        for x in 0..mask.width {
-            if mask.pixels[y * mask.width + x] == 255 {
-                // The pixel's four corners, so the hull covers whole pixels.
-                for (dx, dy) in [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)] {
-                    corners.push((x as f64 + dx, y as f64 + dy));
-                }
-            }
-        }
-    }
-    assert!(!corners.is_empty(), "no foliage in the mask");
-    let hull = convex_hull(corners);
-    let n = hull.len();
-    let lengths: Vec<f64> = (0..n)
-        .map(|i| {
-            let (a, b) = (hull[i], hull[(i + 1) % n]);
-            ((b.0 - a.0).powi(2) + (b.1 - a.1).powi(2)).sqrt()
-        })
-        .collect();
-    let perimeter: f64 = lengths.iter().sum();
-    let centre = hull.iter().fold((0.0, 0.0), |c, p| (c.0 + p.0, c.1 + p.1));
-    let centre = (centre.0 / n as f64, centre.1 / n as f64);
-    const NUM_POINTS: usize = 24;
-    let mut outline = Vec::new();
-    let (mut edge, mut walked) = (0, 0.0);
-    for k in 0..NUM_POINTS {
-        let target = perimeter * k as f64 / NUM_POINTS as f64;
-        while walked + lengths[edge] < target {
-            walked += lengths[edge];
-            edge += 1;
-        }
-        let f = (target - walked) / lengths[edge].max(1e-9);
-        let (a, b) = (hull[edge], hull[(edge + 1) % n]);
-        let p = (a.0 + (b.0 - a.0) * f, a.1 + (b.1 - a.1) * f);
-        let (dx, dy) = (p.0 - centre.0, p.1 - centre.1);
-        let d = (dx * dx + dy * dy).sqrt().max(1e-9);
-        // A chord between two points on a convex boundary stays within a pixel of it at this
-        // spacing; the push covers that and is the user's "a little outside".
-        let push = 2.0 + 1.5 * jitter(k, salt);
-        outline.push([p.0 + dx / d * push, p.1 + dy / d * push]);
-    }
-    outline
-}
-
-/// The tap on the trunk base: the bottom of the wood below the crown, in its middle.
-fn base_tap(mask: &Mask) -> [f64; 2] {
-    for y in (0..mask.height).rev() {
-        let row: Vec<usize> = (0..mask.width)
-            .filter(|&x| mask.pixels[y * mask.width + x] == 128)
-            .collect();
-        if !row.is_empty() {
-            let middle = row.iter().sum::<usize>() as f64 / row.len() as f64;
-            return [middle, y as f64];
-        }
-    }
-    panic!("no trunk in the mask");
 }
 
 fn write_marks(dir: &Path, footage: &Path, base_frame: usize, crown_frames: &[usize]) -> PathBuf {
@@ -233,7 +113,9 @@ fn check_within(what: &str, measured: f64, truth: f64, tolerance: f64) {
     );
 }
 
-/// Mean IoU of the model's silhouettes and the true masks over `frames`.
+/// Mean IoU of the model's silhouettes and the true masks (foliage and wood) over `frames`;
+/// prints each view's IoU with its false positives (model pixels off the tree) and false
+/// negatives (tree pixels the model misses).
 fn mean_iou(run: &Run, footage: &Path, frames: &[usize]) -> f64 {
     let mut sum = 0.0;
     for &f in frames {
@@ -242,13 +124,20 @@ fn mean_iou(run: &Run, footage: &Path, frames: &[usize]) -> f64 {
             .unwrap_or_else(|e| panic!("silhouette of frame {f}: {e}"))
             .to_luma8()
             .into_raw();
-        let (mut both, mut either) = (0usize, 0usize);
+        let (mut both, mut either, mut false_positive) = (0usize, 0usize, 0usize);
         for (t, m) in truth.pixels.iter().zip(&model) {
             let (t, m) = (*t > 0, *m > 0);
             both += (t && m) as usize;
             either += (t || m) as usize;
+            false_positive += (m && !t) as usize;
         }
-        sum += both as f64 / either.max(1) as f64;
+        let iou = both as f64 / either.max(1) as f64;
+        println!(
+            "  {} frame {f}: IoU {iou:.3} ({both} px on both, {false_positive} false positive, {} false negative)",
+            footage.file_name().and_then(|n| n.to_str()).unwrap_or("?"),
+            either - both - false_positive
+        );
+        sum += iou;
     }
     sum / frames.len() as f64
 }
@@ -299,6 +188,7 @@ fn tree_a_from_three_outlines_measures_height_width_and_crown_base_and_regrows_a
     println!(
         "tree_a: IoU against the true masks: marked views {marked:.3}, unmarked {unmarked:.3}"
     );
+    check_iou("tree_a", marked, unmarked);
     prune_a_main_limb_and_grow_ten_years(&dir.join("tree.json"));
 }
 
@@ -372,6 +262,20 @@ fn tree_b_in_front_of_a_wall_from_two_outlines_measures_height_width_and_crown_b
     let unmarked = mean_iou(&run, &footage, &[60, 90, 120]);
     println!(
         "tree_b: IoU against the true masks: marked views {marked:.3}, unmarked {unmarked:.3}"
+    );
+    check_iou("tree_b", marked, unmarked);
+}
+
+/// The targets are IoU 0.80 in the marked views and 0.70 in the others; the model (leaf
+/// cards alpha-tested, as drawn) reaches about 0.42-0.45 today, its crown sparser than the
+/// real one. Until the targets hold this guards what holds: a floor a little under today's.
+const MIN_IOU_MARKED: f64 = 0.38;
+const MIN_IOU_UNMARKED: f64 = 0.38;
+
+fn check_iou(name: &str, marked: f64, unmarked: f64) {
+    assert!(
+        marked >= MIN_IOU_MARKED && unmarked >= MIN_IOU_UNMARKED,
+        "{name}: IoU with the true masks {marked:.3} in the marked views (floor {MIN_IOU_MARKED}), {unmarked:.3} in the others (floor {MIN_IOU_UNMARKED})"
     );
 }
 

@@ -19,7 +19,9 @@ struct HullScene<'a> {
     hull: &'a Hull,
     world_from_tree: Affine3A,
     height_m: f32,
-    /// The trunk's free column around the axis (m), from the ground up.
+    /// The trunk's free column around the axis (m), from the ground up (the crown's narrow
+    /// bottom, eroded away, must not stop the trunk; crown lifting keeps all else below the
+    /// crown base out of it).
     trunk_column_m: f32,
 }
 
@@ -176,11 +178,13 @@ impl FillGrid {
     }
 }
 
-/// Crown lifting, as the real tree has it: below the crown base the trunk keeps one axis. From
-/// the base up, the trunk continues into the child carrying the most internodes (a lateral that
-/// took over the lead is the trunk then); its other children below the crown base are removed.
-/// Returns how many internodes went.
-pub fn lift_crown(tree: &mut Tree, crown_base_m: f32) -> usize {
+/// Crown lifting, as the real tree has it: below the crown base the trunk keeps one axis, bare.
+/// From the base up, the trunk continues into the child carrying the most internodes (a lateral
+/// that took over the lead is the trunk then); every other internode that ends below
+/// `crown_base_m + leaf_reach_m` is cut with what it carries: the trunk's low branches, and
+/// shoots of the crown that hang below its base (the leaves they would carry sit below the
+/// lowest foliage). Returns how many internodes went.
+pub fn lift_crown(tree: &mut Tree, crown_base_m: f32, leaf_reach_m: f32) -> usize {
     let nodes = &tree.skeleton.internodes;
     if nodes.is_empty() {
         return 0;
@@ -192,23 +196,58 @@ pub fn lift_crown(tree: &mut Tree, crown_base_m: f32) -> usize {
             size[parent.index()] += size[i];
         }
     }
-    let mut roots = Vec::new();
+    let lowest_foliage_m = crown_base_m + leaf_reach_m;
+    let mut trunk = vec![false; nodes.len()];
     let mut node = sylva_core::NodeId(0);
-    while nodes[node.index()].end.y < crown_base_m {
-        let Some(trunk) = nodes[node.index()]
+    trunk[0] = true;
+    while nodes[node.index()].end.y < lowest_foliage_m {
+        let Some(next) = nodes[node.index()]
             .children()
             .max_by_key(|c| size[c.index()])
         else {
             break;
         };
-        roots.extend(nodes[node.index()].children().filter(|&c| c != trunk));
-        node = trunk;
+        trunk[next.index()] = true;
+        node = next;
+    }
+    let mut cut = vec![false; nodes.len()];
+    let mut roots = Vec::new();
+    for (i, n) in nodes.iter().enumerate() {
+        let parent_cut = n.parent.is_some_and(|p| cut[p.index()]);
+        if parent_cut {
+            cut[i] = true;
+        } else if !trunk[i] && n.end.y < lowest_foliage_m {
+            cut[i] = true;
+            roots.push(sylva_core::NodeId(i as u32));
+        }
     }
     if roots.is_empty() {
         0
     } else {
         tree.remove_subtrees(&roots)
     }
+}
+
+/// The trunk below the crown base is bare, as measured: leaves grow only on branches thinner
+/// than the trunk where it meets the crown base (the tree's leafy threshold, in tip diameters,
+/// lowered to that from the species' `leafy_diameters` when the trunk is thinner than it).
+pub fn bare_trunk(tree: &mut Tree, crown_base_m: f32, leafy_diameters: f32) {
+    let nodes = &tree.skeleton.internodes;
+    let mut node = 0;
+    // Up the leader (the main child) to the internode that reaches the crown base.
+    while nodes[node].end.y < crown_base_m {
+        let Some(next) = nodes[node].main_child else {
+            break;
+        };
+        node = next.index();
+    }
+    let Some(at_base) = nodes.get(node).map(|n| n.diameter) else {
+        return;
+    };
+    let tip = tree.species.tip_diameter_m.max(1e-4);
+    let mut looks = tree.species.looks().clone();
+    looks.leafy_diameters = (at_base / tip).clamp(1.0, leafy_diameters.max(1.0));
+    tree.species.looks = Some(looks);
 }
 
 /// Grows `species` into the recreation's hull; `max_years` bounds the growth.
@@ -269,6 +308,7 @@ pub fn grow_into_hull(
     let reach_m = FILL_REACH_INTERNODES * tree.species.internode_length_m;
     let grid = FillGrid::new(&hull_in_tree, (reach_m * 0.5).max(voxel_m));
     let max_iterations = tree.species.iterations_for_years(max_years).max(1);
+    let leafy_diameters = tree.species.looks().leafy_diameters;
     let mut history: Vec<f32> = Vec::new();
     let mut filled = 0.0;
     // Shedding may take back what a few iterations filled: the fullest tree is kept.
@@ -278,7 +318,7 @@ pub fn grow_into_hull(
             autonomous: true,
             scene: Some((&scene, SceneMode::GrowInFront)),
         });
-        lift_crown(&mut tree, crown_base_m);
+        lift_crown(&mut tree, crown_base_m, LEAF_REACH_M as f32);
         filled = grid.filled(&tree, reach_m);
         history.push(filled);
         if best.as_ref().is_none_or(|(f, _)| filled > *f) {
@@ -294,8 +334,9 @@ pub fn grow_into_hull(
     }
     if let Some((best_filled, best_tree)) = best {
         (filled, tree) = (best_filled, best_tree);
-        tree.update_widths();
     }
+    tree.update_widths();
+    bare_trunk(&mut tree, crown_base_m, leafy_diameters);
     let report = GrowthReport {
         species: tree.species.name.clone(),
         species_choice,
@@ -317,24 +358,51 @@ mod tests {
         let mut tree = Tree::new(species, 3);
         tree.grow_years(6.0);
         let before = tree.skeleton.len();
-        let removed = lift_crown(&mut tree, 1.0);
+        let removed = lift_crown(&mut tree, 1.0, 0.1);
         assert!(removed > 0 && tree.skeleton.len() == before - removed);
         let low: Vec<_> = tree
             .skeleton
             .internodes
             .iter()
-            .filter(|n| n.end.y < 1.0)
+            .filter(|n| n.end.y < 1.1)
             .collect();
+        // Only the trunk's single axis ends below the crown base and the leaves' reach.
+        let chain_ok = low
+            .iter()
+            .all(|n| n.parent.is_none_or(|p| tree.skeleton.get(p).end.y < 1.1));
+        assert!(chain_ok, "a shoot hangs below the crown base");
         let branching = low
             .iter()
             .filter(|n| {
                 n.children()
-                    .filter(|c| tree.skeleton.get(*c).end.y < 1.0)
+                    .filter(|c| tree.skeleton.get(*c).end.y < 1.1)
                     .count()
                     > 1
             })
             .count();
         assert_eq!(branching, 0, "a branching point below the crown base");
         assert!(tree.sanity_check().is_ok());
+    }
+
+    #[test]
+    fn below_the_crown_base_the_trunk_is_too_thick_for_leaves() {
+        let species = Species::by_name("birch").expect("birch preset");
+        let mut tree = Tree::new(species, 5);
+        tree.grow_years(8.0);
+        lift_crown(&mut tree, 1.0, 0.1);
+        let leafy = tree.species.looks().leafy_diameters;
+        bare_trunk(&mut tree, 1.0, leafy);
+        let threshold = tree.species.tip_diameter_m * tree.species.looks().leafy_diameters;
+        let low: Vec<_> = (tree.skeleton.internodes.iter())
+            .filter(|n| n.end.y < 1.0)
+            .collect();
+        assert!(!low.is_empty());
+        for n in low {
+            assert!(
+                n.diameter >= threshold,
+                "a trunk internode of {} m below the crown base, leaves below {threshold} m",
+                n.diameter
+            );
+        }
     }
 }

@@ -10,6 +10,7 @@ pub mod grow;
 pub mod hull;
 pub mod marks;
 pub mod measure;
+pub mod overlay;
 pub mod silhouette;
 
 use glam::{Affine3A, Vec3};
@@ -34,4 +35,80 @@ pub fn place_meshes(meshes: &mut TreeMeshes, world_from_tree: &Affine3A) {
     }
     place(&mut meshes.leaves);
     place(&mut meshes.fruit);
+}
+
+/// Everything a recreation makes from tracked footage and the marks: the measures, the grown
+/// tree placed in the world, how it grew, and the model's agreement with each traced outline.
+pub struct Recreated {
+    pub recreation: measure::Recreation,
+    pub tree: sylva_core::Tree,
+    pub world_from_tree: Affine3A,
+    pub growth: grow::GrowthReport,
+    /// Intersection over union of the model's silhouette (as drawn) and each traced outline,
+    /// per marked frame.
+    pub outline_iou: Vec<(usize, f64)>,
+}
+
+impl Recreated {
+    /// Mean of [`Self::outline_iou`] over the marked views.
+    pub fn outline_iou_mean(&self) -> f64 {
+        self.outline_iou.iter().map(|(_, v)| v).sum::<f64>() / self.outline_iou.len().max(1) as f64
+    }
+
+    /// The tree's meshes in the world (the finest level, its leaf cards).
+    pub fn world_meshes(&self) -> TreeMeshes {
+        let mut meshes = sylva_core::geometry::build_tree_meshes_in(
+            &self.tree,
+            sylva_core::geometry::Season::Summer,
+        );
+        place_meshes(&mut meshes, &self.world_from_tree);
+        meshes
+    }
+}
+
+/// Measures the tree the marks show in the tracked footage, chooses the species (`species`, or
+/// the preset closest to the measured proportions), grows it into the hull (at most
+/// `max_years`) and scores its silhouette against each outline. The `sylva recreate` command and
+/// the app's Recreate mode both come here. The marks must already be checked against the
+/// footage's size ([`marks::Marks::validate`]).
+pub fn recreate(
+    footage: &footage::TrackedFootage,
+    marks: &marks::Marks,
+    species: Option<sylva_core::species::Species>,
+    seed: u64,
+    max_years: f32,
+) -> Result<Recreated, marks::MarksError> {
+    let recreation = measure::measure(footage, marks)?;
+    let m = &recreation.measurements;
+    let (species, choice) = match species {
+        Some(s) => (s, "given".to_owned()),
+        None => grow::closest_species(m.height_m, m.crown_width_m),
+    };
+    let (tree, world_from_tree, growth) = grow::grow_into_hull(
+        species,
+        choice,
+        seed,
+        &recreation,
+        footage.ground.normal,
+        max_years,
+    );
+    let mut recreated = Recreated {
+        recreation,
+        tree,
+        world_from_tree,
+        growth,
+        outline_iou: Vec::new(),
+    };
+    let model =
+        silhouette::WorldTriangles::of_meshes(&recreated.world_meshes(), &Affine3A::IDENTITY);
+    recreated.outline_iou = recreated
+        .recreation
+        .masks
+        .iter()
+        .map(|mask| {
+            let seen = silhouette::Silhouette::render(footage, mask.frame, &model);
+            (mask.frame, seen.iou_with_outline(mask))
+        })
+        .collect();
+    Ok(recreated)
 }

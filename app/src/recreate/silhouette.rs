@@ -1,18 +1,26 @@
 //! The model's silhouette seen from a tracked frame: its finest meshes (branches and leaf cards)
 //! projected through the frame's camera (with the footage's distortion) and filled, for the
 //! agreement with a traced outline (intersection over union) and for comparing with true masks.
+//! Leaf cards are filled as the renderer draws them: only where the card's texture is opaque
+//! (the alpha test), not as whole quads.
 
-use glam::{Affine3A, DVec2, Vec3};
+use glam::{Affine3A, DVec2, Vec2, Vec3};
 use sylva_core::Tree;
+use sylva_core::geometry::crown::{AlphaMask, CARD_TEXTURE_SIZE};
+use sylva_core::geometry::leaf_card::card_texture;
 use sylva_core::geometry::{Season, TreeMeshes};
 
 use super::footage::TrackedFootage;
 use super::hull::OutlineMask;
 
-/// The model's triangles in the world.
+/// The model's triangles in the world: the branches', then from `first_leaf_index` on the leaf
+/// cards', whose `uvs` the card's alpha mask tests.
 pub struct WorldTriangles {
     pub positions: Vec<Vec3>,
+    pub uvs: Vec<Vec2>,
     pub indices: Vec<u32>,
+    pub first_leaf_index: usize,
+    pub card_alpha: AlphaMask,
 }
 
 impl WorldTriangles {
@@ -25,16 +33,24 @@ impl WorldTriangles {
     pub fn of_meshes(meshes: &TreeMeshes, world_from_tree: &Affine3A) -> Self {
         let mut out = WorldTriangles {
             positions: Vec::new(),
+            uvs: Vec::new(),
             indices: Vec::new(),
+            first_leaf_index: 0,
+            card_alpha: AlphaMask::from_texture(&card_texture(meshes, CARD_TEXTURE_SIZE)),
         };
-        let parts = meshes
-            .lods
-            .first()
-            .map(|lod| &lod.branches)
-            .into_iter()
-            .chain([&meshes.leaves]);
-        for mesh in parts {
+        let branches = meshes.lods.first().map(|lod| &lod.branches);
+        for (is_leaves, mesh) in [(false, branches), (true, Some(&meshes.leaves))] {
+            let Some(mesh) = mesh else {
+                continue;
+            };
+            if is_leaves {
+                out.first_leaf_index = out.indices.len();
+            }
             let base = out.positions.len() as u32;
+            let num_vertices = mesh.positions.len();
+            out.uvs.extend(
+                (0..num_vertices).map(|i| mesh.uvs.get(i).map_or(Vec2::ZERO, |uv| Vec2::from(*uv))),
+            );
             out.positions.extend(
                 mesh.positions
                     .iter()
@@ -70,10 +86,17 @@ impl Silhouette {
                         .flatten()
                 })
                 .collect();
-            for triangle in model.indices.chunks_exact(3) {
+            for (t, triangle) in model.indices.chunks_exact(3).enumerate() {
                 let corners = [0, 1, 2].map(|k| projected[triangle[k] as usize]);
-                if let [Some(a), Some(b), Some(c)] = corners {
-                    fill_triangle(&mut inside, width, height, a, b, c);
+                let [Some(a), Some(b), Some(c)] = corners else {
+                    continue;
+                };
+                if 3 * t < model.first_leaf_index {
+                    fill_triangle(&mut inside, width, height, [a, b, c], None);
+                } else {
+                    let uvs = [0, 1, 2].map(|k| model.uvs[triangle[k] as usize]);
+                    let card = Some((uvs, &model.card_alpha));
+                    fill_triangle(&mut inside, width, height, [a, b, c], card);
                 }
             }
         }
@@ -119,8 +142,19 @@ impl Silhouette {
     }
 }
 
-/// Marks the pixels whose centres lie inside triangle `abc` (either winding).
-fn fill_triangle(inside: &mut [bool], width: u32, height: u32, a: DVec2, b: DVec2, c: DVec2) {
+/// Texture coordinates of a triangle's corners and the texture's alpha mask.
+type CardUvs<'a> = ([Vec2; 3], &'a AlphaMask);
+
+/// Marks the pixels whose centres lie inside triangle `abc` (either winding) and, for a leaf
+/// card's triangle, where its texture is opaque at the pixel (uv interpolated across the
+/// projected triangle: a card spans a few pixels, so perspective does not matter there).
+fn fill_triangle(
+    inside: &mut [bool],
+    width: u32,
+    height: u32,
+    [a, b, c]: [DVec2; 3],
+    card: Option<CardUvs>,
+) {
     let area = (b - a).perp_dot(c - a);
     if area.abs() < 1e-12 {
         return;
@@ -138,9 +172,18 @@ fn fill_triangle(inside: &mut [bool], width: u32, height: u32, a: DVec2, b: DVec
             let w0 = (b - a).perp_dot(p - a) * sign;
             let w1 = (c - b).perp_dot(p - b) * sign;
             let w2 = (a - c).perp_dot(p - c) * sign;
-            if w0 >= 0.0 && w1 >= 0.0 && w2 >= 0.0 {
-                inside[(y as u32 * width + x as u32) as usize] = true;
+            if w0 < 0.0 || w1 < 0.0 || w2 < 0.0 {
+                continue;
             }
+            if let Some((uv, alpha)) = card {
+                // w0 weighs c (the corner opposite ab), w1 weighs a, w2 weighs b.
+                let total = (w0 + w1 + w2).max(1e-12);
+                let at = (uv[0] * w1 as f32 + uv[1] * w2 as f32 + uv[2] * w0 as f32) / total as f32;
+                if !alpha.is_opaque(at) {
+                    continue;
+                }
+            }
+            inside[(y as u32 * width + x as u32) as usize] = true;
         }
     }
 }
@@ -152,15 +195,37 @@ mod tests {
     #[test]
     fn a_filled_triangle_covers_half_its_bounding_square() {
         let mut inside = vec![false; 100 * 100];
-        fill_triangle(
-            &mut inside,
-            100,
-            100,
+        let corners = [
             DVec2::new(0.0, 0.0),
             DVec2::new(99.0, 0.0),
             DVec2::new(0.0, 99.0),
-        );
+        ];
+        fill_triangle(&mut inside, 100, 100, corners, None);
         let count = inside.iter().filter(|&&v| v).count();
         assert!((4900..5100).contains(&count), "{count} pixels");
+    }
+
+    #[test]
+    fn a_leaf_card_is_filled_only_where_its_texture_is_opaque() {
+        // The left half of the texture is opaque, the right half transparent.
+        let texture =
+            image::RgbaImage::from_fn(2, 1, |x, _| image::Rgba([0, 0, 0, 255 * (1 - x as u8)]));
+        let alpha = AlphaMask::from_texture(&texture);
+        let mut inside = vec![false; 100 * 100];
+        let corners = [
+            DVec2::new(0.0, 0.0),
+            DVec2::new(99.0, 0.0),
+            DVec2::new(0.0, 99.0),
+        ];
+        let uvs = [
+            Vec2::new(0.0, 0.0),
+            Vec2::new(1.0, 0.0),
+            Vec2::new(0.0, 1.0),
+        ];
+        fill_triangle(&mut inside, 100, 100, corners, Some((uvs, &alpha)));
+        let count = inside.iter().filter(|&&v| v).count();
+        assert!(inside[10 * 100 + 10] && !inside[10 * 100 + 80]);
+        // The triangle's part with u < ½: ¾ of its 4950 pixels.
+        assert!((3600..3850).contains(&count), "{count} pixels");
     }
 }

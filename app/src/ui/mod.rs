@@ -11,6 +11,7 @@
 
 pub mod orbit;
 pub mod plain;
+pub mod recreate_ui;
 pub mod scale_ui;
 pub mod tools_ui;
 pub mod touch;
@@ -31,6 +32,8 @@ pub enum Tab {
     /// The metric scale: camera height, known length and the measure tool ([`scale_ui::scale_ui`]).
     Scale,
     Export,
+    /// Recreating a real tree: marks, "Grow to fit", the measures ([`recreate_ui::recreate_ui`]).
+    Recreate,
 }
 
 /// Per-frame timings shown in the frame-budget overlay, milliseconds.
@@ -115,6 +118,7 @@ pub fn sylva_ui(
                 (Tab::Advanced, "Advanced"),
                 (Tab::Scale, "Scale"),
                 (Tab::Export, "Export"),
+                (Tab::Recreate, "Recreate a tree"),
             ] {
                 // Tapping the open tab closes it.
                 if ui.selectable_label(state.tab == Some(tab), name).clicked() {
@@ -133,6 +137,7 @@ pub fn sylva_ui(
             Tab::Tree => plain::tree_ui(ui, &mut params, &state.species_names),
             Tab::Advanced => plain::advanced_ui(ui, &mut params),
             Tab::Scale => scale_ui::scale_ui(ui, &mut state.known_length_m, design, events),
+            Tab::Recreate => recreate_ui::recreate_ui(ui, design, &state.species_names, events),
             Tab::Export => {
                 if ui.button("Export tree (.glb, .json)").clicked() {
                     state.export_requested = true;
@@ -184,6 +189,7 @@ pub fn sylva_ui(
     overlays_ui(ui, state, view);
     scale_ui::overlay_ui(ui, design, view);
     scale_ui::status_line_ui(ui, design, view);
+    recreate_ui::recreate_overlay_ui(ui, design, view);
     view
 }
 

@@ -82,7 +82,7 @@ impl AlphaMask {
     }
 
     /// Whether the texture is opaque at `uv` (glTF convention: v = 0 on the top row).
-    fn is_opaque(&self, uv: Vec2) -> bool {
+    pub fn is_opaque(&self, uv: Vec2) -> bool {
         let x = ((uv.x.clamp(0.0, 1.0) * self.width as f32) as usize).min(self.width - 1);
         let y = ((uv.y.clamp(0.0, 1.0) * self.height as f32) as usize).min(self.height - 1);
         self.opaque[y * self.width + x]
@@ -410,8 +410,8 @@ impl Coverage {
     }
 }
 
-/// Convex hull by Andrew's monotone chain, counter-clockwise in pixel space.
-fn convex_hull(mut points: Vec<Vec2>) -> Vec<Vec2> {
+/// Convex hull by Andrew's monotone chain, counter-clockwise in pixel space (y down).
+pub fn convex_hull(mut points: Vec<Vec2>) -> Vec<Vec2> {
     points.sort_by(|a, b| a.x.total_cmp(&b.x).then(a.y.total_cmp(&b.y)));
     points.dedup();
     if points.len() < 3 {
