@@ -1,9 +1,11 @@
 //! The desktop window (winit + wgpu + egui): plays footage, shows the AR view with the tree and
 //! the UI, and records a session of everything the user does.
 //!
-//! Seeking ahead of what the tracker has seen never freezes the window: recorded footage is
-//! tracked once, in order, so a seek past the last tracked frame fast-forwards to it, showing
-//! the frames on the way (each tracked once; at most [`SEEK_BUDGET`] of them per redraw) with a
+//! Recorded footage is tracked on a worker thread ([`crate::tracking_worker`]): a redraw shows
+//! the next frame once the tracker has it and never waits for it. Seeking ahead of what the
+//! tracker has seen never freezes the window: frames are tracked once, in order, so a seek past
+//! the last tracked frame asks the worker for the frames up to it and fast-forwards as they
+//! come, showing the frames on the way (at most [`SEEK_BUDGET`] of them per redraw) with a
 //! progress line, and a seek back jumps at once. `--frame-report N` measures the redraws
 //! ([`crate::frame_report`]).
 
@@ -48,9 +50,8 @@ struct DesktopApp {
     restore_offer: Option<crate::autosave::PreviousAutosave>,
 }
 
-/// How long a redraw may spend catching up a seek before it draws (the window shows the
-/// progress at least this often, and few redraws keep the catching up quick where drawing is
-/// slow, as on a software renderer).
+/// How long a redraw may spend showing the tracked frames of a seek before it draws (the window
+/// shows the progress at least this often).
 pub const SEEK_BUDGET: std::time::Duration = std::time::Duration::from_millis(200);
 
 /// How the window opens.
@@ -272,14 +273,19 @@ impl DesktopApp {
         match self.seek_target {
             Some(target) => {
                 let started = Instant::now();
+                self.player.track_ahead_to(target);
                 loop {
                     let next = match self.tracked_until {
                         None => 0,
                         // Frames up to the last tracked one are cached: jump there.
                         Some(last) if self.player.frame < last => last,
                         Some(_) => self.player.frame + 1,
-                    };
-                    self.player.show_frame(next.min(target))?;
+                    }
+                    .min(target);
+                    if !self.player.frame_ready(next)? {
+                        break; // the tracker is still on it: draw meanwhile
+                    }
+                    self.player.show_frame(next)?;
                     self.note_tracked();
                     if self.player.frame >= target || started.elapsed() >= SEEK_BUDGET {
                         break;
@@ -306,6 +312,10 @@ impl DesktopApp {
 
     fn redraw(&mut self) -> anyhow::Result<()> {
         let redraw_started = Instant::now();
+        let process_cpu_s = self
+            .frame_times
+            .as_ref()
+            .map_or(0.0, |_| crate::frame_report::process_cpu_s());
         let frame_ms = self
             .frame_times
             .as_mut()
@@ -345,6 +355,7 @@ impl DesktopApp {
                 ui_ms: (draw_ms - render_ms).max(0.0),
                 present_ms: present_started.elapsed().as_secs_f32() * 1000.0,
                 seeking,
+                process_cpu_s,
             };
             times.record(sample, self.player.frame);
         }

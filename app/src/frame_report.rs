@@ -1,7 +1,9 @@
 //! The window's frame-time report (`sylva view --frame-report N`): how long the UI takes per
 //! drawn frame while footage plays and the tracker runs, as a median and a 95th percentile, with
 //! the parts of a redraw (playing and tracking the footage, drawing the AR view, the UI,
-//! submitting and presenting). A report, printed once, not a timed test.
+//! submitting and presenting), and the process's CPU time per redraw (every thread: the UI, the
+//! tracker's worker, lavapipe's rasteriser threads) with the load average, which on a loaded
+//! machine say more than the wall-clock figures. A report, printed once, not a timed test.
 
 use std::fmt;
 use std::time::Instant;
@@ -25,6 +27,29 @@ pub struct FrameSample {
     pub present_ms: f32,
     /// The redraw happened while a seek was still catching up.
     pub seeking: bool,
+    /// CPU time the process had used at the start of the redraw, seconds ([`process_cpu_s`]).
+    pub process_cpu_s: f64,
+}
+
+/// CPU time used by the process so far (all its threads, user and system), seconds; 0 where
+/// the platform does not say.
+pub fn process_cpu_s() -> f64 {
+    #[cfg(unix)]
+    {
+        // SAFETY: getrusage only writes the struct it is given.
+        let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+        if unsafe { libc::getrusage(libc::RUSAGE_SELF, &mut usage) } == 0 {
+            let seconds = |t: libc::timeval| t.tv_sec as f64 + t.tv_usec as f64 * 1e-6;
+            return seconds(usage.ru_utime) + seconds(usage.ru_stime);
+        }
+    }
+    0.0
+}
+
+/// The one-minute load average (`/proc/loadavg`), if the system has one.
+pub fn load_average() -> Option<f32> {
+    let text = std::fs::read_to_string("/proc/loadavg").ok()?;
+    text.split_whitespace().next()?.parse().ok()
 }
 
 /// Frame samples of a window, up to a count.
@@ -107,9 +132,23 @@ impl FrameTimes {
             render: stat(|s| s.render_ms),
             ui: stat(|s| s.ui_ms),
             present: stat(|s| s.present_ms),
+            cpu_ms_per_frame: cpu_ms_per_frame(&self.samples),
+            load_average: load_average(),
             num_drawn_while_seeking: self.num_seek_redraws,
             footage: self.footage.unwrap_or_default(),
         })
+    }
+}
+
+/// The process's CPU time per redraw between the first and the last sample's start,
+/// milliseconds (0 with fewer than two samples).
+fn cpu_ms_per_frame(samples: &[FrameSample]) -> f32 {
+    match (samples.first(), samples.last()) {
+        (Some(first), Some(last)) if samples.len() > 1 => {
+            let used_s = last.process_cpu_s - first.process_cpu_s;
+            (used_s * 1000.0 / (samples.len() - 1) as f64) as f32
+        }
+        _ => 0.0,
     }
 }
 
@@ -141,6 +180,10 @@ pub struct FrameReport {
     pub render: Stat,
     pub ui: Stat,
     pub present: Stat,
+    /// CPU time of the whole process (every thread) per measured redraw, milliseconds.
+    pub cpu_ms_per_frame: f32,
+    /// The one-minute load average when the report was made.
+    pub load_average: Option<f32>,
     /// Redraws made while a seek was catching up, from the window's first one (the window kept
     /// drawing).
     pub num_drawn_while_seeking: usize,
@@ -173,7 +216,14 @@ impl fmt::Display for FrameReport {
                 stat.median_ms, stat.p95_ms, stat.max_ms
             )?;
         }
-        Ok(())
+        let load = self
+            .load_average
+            .map_or_else(|| "unknown".to_string(), |l| format!("{l:.2}"));
+        writeln!(
+            f,
+            "  process  cpu_ms_per_frame={:.1} load_average={load}",
+            self.cpu_ms_per_frame
+        )
     }
 }
 
@@ -199,6 +249,7 @@ mod tests {
             let sample = FrameSample {
                 frame_ms: i as f32,
                 seeking: i < 5,
+                process_cpu_s: 0.01 * i as f64,
                 ..FrameSample::default()
             };
             times.record(sample, i as usize);
@@ -211,6 +262,7 @@ mod tests {
         assert_eq!(report.footage, (first, first + 2));
         assert_eq!(report.frame.median_ms, (first + 1) as f32);
         assert_eq!(report.num_drawn_while_seeking, 5);
+        assert!((report.cpu_ms_per_frame - 10.0).abs() < 1e-3);
         assert!(report.to_string().contains("frames=3"));
     }
 }

@@ -31,5 +31,6 @@ pub mod session;
 pub mod state;
 #[cfg(not(any(target_os = "android", target_os = "ios")))]
 pub mod track_plot;
+pub mod tracking_worker;
 pub mod tree_model;
 pub mod ui;

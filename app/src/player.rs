@@ -11,9 +11,10 @@ use image::RgbaImage;
 use crate::footage::{Footage, FootageFrame};
 use crate::live::{FootageRecorder, LiveFrame, LiveNext, LiveStream, intrinsics_of};
 use crate::render::{GroundPlane, ViewCamera};
-use crate::scene_tracking::{SceneFrame, SceneTracker};
+use crate::scene_tracking::SceneFrame;
 use crate::session::{Session, frame_dt};
 use crate::state::{DesignState, InputEvent, Parameters, TouchPhase};
+use crate::tracking_worker::TrackedFootage;
 use crate::ui::UiState;
 
 /// Seed of trees planted by the app.
@@ -21,8 +22,9 @@ pub const DEFAULT_SEED: u64 = 7;
 
 /// Where the shown frames come from.
 enum Scenes {
-    /// A TUM folder: frames tracked once, in order, and cached for seeking and looping.
-    Recorded(Box<SceneTracker>),
+    /// A TUM folder: frames tracked once, in order, on a worker thread, and cached for seeking
+    /// and looping.
+    Recorded(Box<TrackedFootage>),
     /// A stream: each frame tracked as it arrives and shown once.
     Live(Box<LiveState>),
 }
@@ -54,14 +56,15 @@ pub struct Player {
 }
 
 impl Player {
-    /// A player over `footage` (recorded in sessions as `footage_ref`), tracking it as it plays.
+    /// A player over `footage` (recorded in sessions as `footage_ref`), tracking it as it plays
+    /// on a worker thread ([`TrackedFootage::on_worker`]).
     pub fn new(footage: Footage, footage_ref: PathBuf) -> anyhow::Result<Player> {
         let params = Parameters::default();
         let ui = UiState {
             num_frames: footage.len(),
             ..UiState::default()
         };
-        let tracker = SceneTracker::open(&footage.root, footage.intrinsics)?;
+        let tracker = TrackedFootage::on_worker(&footage.root, footage.intrinsics, footage.len())?;
         Ok(Player {
             session: Session::new(footage_ref, DEFAULT_SEED, params.clone()),
             design: DesignState::unplanted(DEFAULT_SEED, params)
@@ -168,6 +171,22 @@ impl Player {
     pub fn brush_sphere(&self) -> Option<(Vec3, f32)> {
         let stroke = self.design.stroke.as_ref()?;
         Some((*stroke.points.last()?, self.design.params.brush_radius))
+    }
+
+    /// Whether footage frame `index` is tracked, so that showing it does not wait for the
+    /// tracker (asks the tracker for it when not); always true for a stream.
+    pub fn frame_ready(&mut self, index: usize) -> anyhow::Result<bool> {
+        match &mut self.scenes {
+            Scenes::Recorded(tracker) => Ok(tracker.ready(index)?.is_some()),
+            Scenes::Live(_) => Ok(true),
+        }
+    }
+
+    /// Asks the tracker to track up to footage frame `index` (a seek's target) without waiting.
+    pub fn track_ahead_to(&mut self, index: usize) {
+        if let Scenes::Recorded(tracker) = &mut self.scenes {
+            tracker.ask(index);
+        }
     }
 
     /// Applies and records an input event.
@@ -334,16 +353,20 @@ impl Player {
             return self.show_frame(target);
         }
         let last = self.last_tick_s.replace(now_s);
+        // The frame is shown once the tracker has it; until then the window draws the last one.
         if self.image.is_none() {
-            return self.show_frame(self.frame);
+            if self.frame_ready(self.frame)? {
+                self.show_frame(self.frame)?;
+            }
+            return Ok(());
         }
         if !self.ui.playing {
             return Ok(());
         }
         self.frame_clock_s += now_s - last.unwrap_or(now_s);
-        if self.frame_clock_s >= 1.0 / 30.0 {
+        let next = (self.frame + 1) % self.footage.len().max(1);
+        if self.frame_clock_s >= 1.0 / 30.0 && self.frame_ready(next)? {
             self.frame_clock_s = 0.0;
-            let next = (self.frame + 1) % self.footage.len().max(1);
             self.show_frame(next)?;
         }
         Ok(())

@@ -22,10 +22,12 @@ pub struct ViewDrawer {
 }
 
 impl ViewDrawer {
-    /// A drawer for surfaces of `format`.
+    /// A drawer for surfaces of `format`, multisampled as suits the adapter for an interactive
+    /// view ([`crate::render::interactive_sample_count`]: 4× on a GPU, 1× on a CPU rasteriser).
     pub fn new(gpu: &Gpu, format: wgpu::TextureFormat) -> ViewDrawer {
+        let samples = crate::render::interactive_sample_count(&gpu.adapter.get_info());
         ViewDrawer {
-            renderer: Renderer::new(gpu, format),
+            renderer: Renderer::with_samples(gpu, format, samples),
             egui_ctx: egui::Context::default(),
             egui_renderer: egui_wgpu::Renderer::new(&gpu.device, format, Default::default()),
             tree_mesher: Default::default(),

@@ -1,6 +1,9 @@
 //! The wgpu renderer: one code path for the window and for headless (offscreen) frames.
 //!
-//! A frame is: the sun's shadow map of the tree, then one 4× MSAA pass: camera image (undistorted
+//! A frame is: the sun's shadow map of the tree (drawn again only when the tree, the sun or the
+//! drawn level of detail changes, not per camera frame), then one scene pass — 4× MSAA on a GPU
+//! and in offscreen frames, one sample with alpha-tested leaf edges for an interactive view on a
+//! CPU rasteriser ([`interactive_sample_count`]): camera image (undistorted
 //! for display), the scene's depth mesh into depth only (so the real scene hides the tree), the
 //! ground plane (a shadow catcher over the camera image, or a lawn outside AR), bark with the
 //! species' bark texture, leaf cards, then debug views (depth-mesh wireframe, feature points,
@@ -21,6 +24,7 @@ pub mod mesh;
 pub mod offscreen;
 mod pipelines;
 pub mod resources;
+pub mod shadow;
 pub mod textures;
 mod tree_gpu;
 
@@ -30,6 +34,7 @@ pub use mesh::{
     CardInstance, GroundPlane, LitMesh, LitVertex, OccluderMesh, TreeLevel, TreeLook, TreeMesh,
 };
 pub use offscreen::Offscreen;
+pub use pipelines::{SAMPLE_COUNT, interactive_sample_count};
 pub use resources::Renderer;
 
 use glam::Vec3;

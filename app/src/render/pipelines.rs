@@ -4,11 +4,24 @@ use crate::render::mesh::{CardInstance, LitVertex};
 
 /// Depth format of the scene and of the sun's shadow map.
 pub const DEPTH_FORMAT: wgpu::TextureFormat = wgpu::TextureFormat::Depth32Float;
-/// MSAA samples of the scene pass (leaves use alpha to coverage).
+/// MSAA samples of the scene pass on a real GPU and in offscreen frames (leaves use alpha to
+/// coverage).
 pub const SAMPLE_COUNT: u32 = 4;
+
+/// The scene pass's samples for an interactive view on `adapter`: [`SAMPLE_COUNT`] on a GPU; one
+/// on a CPU rasteriser (lavapipe), where every sample is rasterised and resolved on the CPU, the
+/// leaves' edges then cut by an alpha test instead of coverage.
+pub fn interactive_sample_count(adapter: &wgpu::AdapterInfo) -> u32 {
+    match adapter.device_type {
+        wgpu::DeviceType::Cpu => 1,
+        _ => SAMPLE_COUNT,
+    }
+}
 
 /// Every pipeline the scene pass and the shadow pass use.
 pub struct Pipelines {
+    /// MSAA samples of the scene pass's targets.
+    pub sample_count: u32,
     pub scene_layout: wgpu::BindGroupLayout,
     pub shadow_layout: wgpu::BindGroupLayout,
     /// Group 1 of every pipeline: the tree's leaf card and bark textures and their sampler.
@@ -18,7 +31,8 @@ pub struct Pipelines {
     pub ground_shadow: wgpu::RenderPipeline,
     pub ground_lawn: wgpu::RenderPipeline,
     pub branches: wgpu::RenderPipeline,
-    /// Leaf cards: instances of one quad, alpha to coverage, lit on both sides.
+    /// Leaf cards: instances of one quad, alpha to coverage (an alpha test at one sample), lit on
+    /// both sides.
     pub cards: wgpu::RenderPipeline,
     pub fruit: wgpu::RenderPipeline,
     pub wire: wgpu::RenderPipeline,
@@ -101,7 +115,12 @@ impl Spec<'_> {
 }
 
 impl Pipelines {
-    pub fn new(device: &wgpu::Device, color_format: wgpu::TextureFormat) -> Self {
+    /// The pipelines for colour targets of `color_format` with `sample_count` samples (1 or 4).
+    pub fn new(
+        device: &wgpu::Device,
+        color_format: wgpu::TextureFormat,
+        sample_count: u32,
+    ) -> Self {
         let shader = device.create_shader_module(wgpu::include_wgsl!("scene.wgsl"));
         let scene_layout = scene_bind_group_layout(device);
         let shadow_layout = device.create_bind_group_layout(&wgpu::BindGroupLayoutDescriptor {
@@ -111,7 +130,8 @@ impl Pipelines {
         let tree_layout = tree_bind_group_layout(device);
         let scene = pipeline_layout(device, &[&scene_layout, &tree_layout]);
         let shadow = pipeline_layout(device, &[&shadow_layout, &tree_layout]);
-        let make = |spec: Spec| make_scene_pipeline(device, &scene, &shader, color_format, spec);
+        let target = (color_format, sample_count);
+        let make = |spec: Spec| make_scene_pipeline(device, &scene, &shader, target, spec);
 
         let background = make(Spec {
             depth_write: false,
@@ -124,7 +144,7 @@ impl Pipelines {
             ..Spec::opaque("occluder", "vs_position", "fs_depth_only")
         });
         let ground_shadow =
-            make(Spec::opaque("ground shadow", "vs_ground", "fs_ground_shadow").blended());
+            make(Spec::opaque("ground shadow", "vs_ground_shadow", "fs_ground_shadow").blended());
         let ground_lawn =
             make(Spec::opaque("ground lawn", "vs_ground", "fs_ground_lawn").blended());
         let branches = make(Spec {
@@ -137,12 +157,21 @@ impl Pipelines {
             cull: Some(wgpu::Face::Back),
             ..Spec::opaque("fruit", "vs_lit", "fs_fruit")
         });
+        let multisampled = sample_count > 1;
         let cards = make(Spec {
             buffer: Some(card_layout()),
-            alpha_to_coverage: true,
+            alpha_to_coverage: multisampled,
             // The alpha goes to coverage only: the frame stays opaque where a leaf's edge is.
             write_mask: wgpu::ColorWrites::COLOR,
-            ..Spec::opaque("leaf cards", "vs_card", "fs_card")
+            ..Spec::opaque(
+                "leaf cards",
+                "vs_card",
+                if multisampled {
+                    "fs_card"
+                } else {
+                    "fs_card_tested"
+                },
+            )
         });
         let wire = make(Spec {
             buffer: Some(position_layout(wgpu::VertexStepMode::Vertex)),
@@ -169,6 +198,7 @@ impl Pipelines {
             Some("fs_shadow_card"),
         );
         Pipelines {
+            sample_count,
             scene_layout,
             shadow_layout,
             tree_layout,
@@ -284,7 +314,7 @@ fn make_scene_pipeline(
     device: &wgpu::Device,
     layout: &wgpu::PipelineLayout,
     shader: &wgpu::ShaderModule,
-    color_format: wgpu::TextureFormat,
+    (color_format, sample_count): (wgpu::TextureFormat, u32),
     spec: Spec,
 ) -> wgpu::RenderPipeline {
     let buffers = [spec.buffer];
@@ -315,7 +345,7 @@ fn make_scene_pipeline(
             bias: Default::default(),
         }),
         multisample: wgpu::MultisampleState {
-            count: SAMPLE_COUNT,
+            count: sample_count,
             mask: !0,
             alpha_to_coverage_enabled: spec.alpha_to_coverage,
         },

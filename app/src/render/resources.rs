@@ -1,12 +1,13 @@
 //! The renderer's GPU resources and the frame it records.
 
 use bytemuck::{Pod, Zeroable};
-use glam::{Mat4, Vec3, Vec4};
+use glam::{Mat4, Vec3};
 
 use crate::render::buffers::{GpuMesh, draw, upload};
 use crate::render::camera::Intrinsics;
 use crate::render::mesh::{OccluderMesh, TreeMesh};
 use crate::render::pipelines::{DEPTH_FORMAT, Pipelines, SAMPLE_COUNT};
+use crate::render::shadow::{GroundPatch, shadow_footprint, sun_clip_from_world};
 use crate::render::tree_gpu::{GpuTree, TreePipelines};
 use crate::render::{FrameView, Gpu, GroundStyle};
 
@@ -33,6 +34,20 @@ struct Globals {
     misc: [f32; 4],
     /// rgb: linear colour of the tree's fruit; w unused.
     fruit_color: [f32; 4],
+    /// The ground the shadow catcher draws: centre and half axes (xyz; w unused).
+    catcher_centre: [f32; 4],
+    catcher_a: [f32; 4],
+    catcher_b: [f32; 4],
+}
+
+/// What the shadow map was drawn for: it is drawn again only when one of these changes (the
+/// tree is uploaded anew, the sun moves, or the drawn level of detail changes), not per camera
+/// frame.
+#[derive(Clone, Copy, Debug, PartialEq)]
+struct ShadowKey {
+    tree_generation: u64,
+    level: usize,
+    light_clip_from_world: Mat4,
 }
 
 struct Background {
@@ -53,14 +68,29 @@ pub struct Renderer {
     scene_group: wgpu::BindGroup,
     shadow_group: wgpu::BindGroup,
     tree: GpuTree,
+    /// Counts [`Renderer::set_tree`] calls: the tree the shadow map shows.
+    tree_generation: u64,
+    /// What the shadow map holds (None before the first frame).
+    shadow_drawn: Option<ShadowKey>,
+    /// Whether the last frame drew the shadow map (rather than reusing it).
+    shadow_redrawn: bool,
     /// The level of detail the last frame drew.
     drawn_level: usize,
     occluder: Option<GpuMesh>,
     wireframe: Option<GpuMesh>,
     points: Option<GpuMesh>,
-    /// MSAA colour and depth targets, with their size.
-    targets: Option<((u32, u32), wgpu::TextureView, wgpu::TextureView)>,
+    /// The scene pass's targets.
+    targets: Option<SceneTargets>,
     color_format: wgpu::TextureFormat,
+}
+
+/// The scene pass's own targets for one size: the multisampled colour (resolved into the
+/// caller's target; None at one sample, which draws into the caller's target directly) and the
+/// depth.
+struct SceneTargets {
+    size: (u32, u32),
+    msaa_color: Option<wgpu::TextureView>,
+    depth: wgpu::TextureView,
 }
 
 fn texture_2d(
@@ -88,10 +118,21 @@ fn texture_2d(
 }
 
 impl Renderer {
-    /// A renderer drawing into targets of `color_format`.
+    /// A renderer drawing into targets of `color_format`, [`SAMPLE_COUNT`]× multisampled (the
+    /// offscreen frames: screenshots, golden images, session hashes).
     pub fn new(gpu: &Gpu, color_format: wgpu::TextureFormat) -> Renderer {
+        Renderer::with_samples(gpu, color_format, SAMPLE_COUNT)
+    }
+
+    /// A renderer whose scene pass takes `sample_count` samples a pixel (1: no multisampling,
+    /// leaf edges by an alpha test; see [`crate::render::interactive_sample_count`]).
+    pub fn with_samples(
+        gpu: &Gpu,
+        color_format: wgpu::TextureFormat,
+        sample_count: u32,
+    ) -> Renderer {
         let device = &gpu.device;
-        let pipelines = Pipelines::new(device, color_format);
+        let pipelines = Pipelines::new(device, color_format, sample_count.max(1));
         let globals = device.create_buffer(&wgpu::BufferDescriptor {
             label: Some("sylva globals"),
             size: std::mem::size_of::<Globals>() as u64,
@@ -153,6 +194,9 @@ impl Renderer {
             scene_group,
             shadow_group,
             tree,
+            tree_generation: 0,
+            shadow_drawn: None,
+            shadow_redrawn: false,
             drawn_level: 0,
             occluder: None,
             wireframe: None,
@@ -166,10 +210,22 @@ impl Renderer {
         self.color_format
     }
 
+    /// MSAA samples of the scene pass.
+    pub fn sample_count(&self) -> u32 {
+        self.pipelines.sample_count
+    }
+
+    /// Whether the last frame drew the sun's shadow map (it is kept while the tree, the sun and
+    /// the drawn level stay the same).
+    pub fn shadow_redrawn(&self) -> bool {
+        self.shadow_redrawn
+    }
+
     /// Uploads the tree (replacing the previous one): every level of detail, and the species'
     /// leaf card and bark textures when its look differs from the last tree's.
     pub fn set_tree(&mut self, gpu: &Gpu, tree: &TreeMesh) {
         self.tree.set(gpu, &self.pipelines, tree);
+        self.tree_generation += 1;
     }
 
     /// The level of detail the last frame drew (0 = finest).
@@ -259,31 +315,28 @@ impl Renderer {
     }
 
     fn ensure_targets(&mut self, device: &wgpu::Device, size: (u32, u32)) {
-        if self.targets.as_ref().is_some_and(|(s, _, _)| *s == size) {
+        if self.targets.as_ref().is_some_and(|t| t.size == size) {
             return;
         }
         let usage = wgpu::TextureUsages::RENDER_ATTACHMENT;
-        let color = texture_2d(
-            device,
-            "msaa colour",
+        let samples = self.pipelines.sample_count;
+        let msaa_color = (samples > 1).then(|| {
+            texture_2d(
+                device,
+                "msaa colour",
+                size,
+                self.color_format,
+                samples,
+                usage,
+            )
+            .create_view(&Default::default())
+        });
+        let depth = texture_2d(device, "scene depth", size, DEPTH_FORMAT, samples, usage);
+        self.targets = Some(SceneTargets {
             size,
-            self.color_format,
-            SAMPLE_COUNT,
-            usage,
-        );
-        let depth = texture_2d(
-            device,
-            "msaa depth",
-            size,
-            DEPTH_FORMAT,
-            SAMPLE_COUNT,
-            usage,
-        );
-        self.targets = Some((
-            size,
-            color.create_view(&Default::default()),
-            depth.create_view(&Default::default()),
-        ));
+            msaa_color,
+            depth: depth.create_view(&Default::default()),
+        });
     }
 
     /// Records one frame into `target` (of `size` pixels, this renderer's colour format).
@@ -298,26 +351,41 @@ impl Renderer {
         self.ensure_targets(&gpu.device, size);
         self.drawn_level = self.level_for(view, size);
         let region = letterbox(size, &view.camera.intrinsics);
-        let globals = self.globals_for(view, region);
+        let light_clip_from_world = self.light_clip_from_world(view);
+        let globals = self.globals_for(view, region, light_clip_from_world);
         gpu.queue
             .write_buffer(&self.globals, 0, bytemuck::bytes_of(&globals));
-        self.shadow_pass(encoder);
-        let Some((_, msaa_color, msaa_depth)) = &self.targets else {
+        let shadow = ShadowKey {
+            tree_generation: self.tree_generation,
+            level: self.drawn_level,
+            light_clip_from_world,
+        };
+        self.shadow_redrawn = self.shadow_drawn != Some(shadow);
+        if self.shadow_redrawn {
+            self.shadow_pass(encoder);
+            self.shadow_drawn = Some(shadow);
+        }
+        let Some(targets) = &self.targets else {
             return;
+        };
+        // Multisampled: drawn into the samples and resolved into `target`; else into `target`.
+        let (color, resolve_target, store) = match &targets.msaa_color {
+            Some(msaa) => (msaa, Some(target), wgpu::StoreOp::Discard),
+            None => (target, None, wgpu::StoreOp::Store),
         };
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("scene"),
             color_attachments: &[Some(wgpu::RenderPassColorAttachment {
-                view: msaa_color,
+                view: color,
                 depth_slice: None,
-                resolve_target: Some(target),
+                resolve_target,
                 ops: wgpu::Operations {
                     load: wgpu::LoadOp::Clear(wgpu::Color::BLACK),
-                    store: wgpu::StoreOp::Discard,
+                    store,
                 },
             })],
             depth_stencil_attachment: Some(wgpu::RenderPassDepthStencilAttachment {
-                view: msaa_depth,
+                view: &targets.depth,
                 depth_ops: Some(wgpu::Operations {
                     load: wgpu::LoadOp::Clear(1.0),
                     store: wgpu::StoreOp::Discard,
@@ -393,7 +461,32 @@ impl Renderer {
         self.tree.draw(&mut pass, self.drawn_level, parts);
     }
 
-    fn globals_for(&self, view: &FrameView, region: [f32; 4]) -> Globals {
+    /// The sun's view of the tree's bounding sphere (the shadow map's projection).
+    fn light_clip_from_world(&self, view: &FrameView) -> Mat4 {
+        let sun = view
+            .lighting
+            .sun_direction
+            .try_normalize()
+            .unwrap_or(Vec3::Y);
+        let (centre, radius) = self.tree_sphere();
+        sun_clip_from_world(sun, centre, radius)
+    }
+
+    /// Centre and radius of the tree's bounding sphere (a unit sphere at the origin without a
+    /// tree).
+    fn tree_sphere(&self) -> (Vec3, f32) {
+        match self.tree.bounds() {
+            Some((lo, hi)) => (0.5 * (lo + hi), (0.5 * (hi - lo)).length().max(0.05)),
+            None => (Vec3::ZERO, 1.0),
+        }
+    }
+
+    fn globals_for(
+        &self,
+        view: &FrameView,
+        region: [f32; 4],
+        light_clip_from_world: Mat4,
+    ) -> Globals {
         let camera = crate::render::ViewCamera {
             intrinsics: view
                 .camera
@@ -403,11 +496,7 @@ impl Renderer {
         };
         let light = &view.lighting;
         let sun = light.sun_direction.try_normalize().unwrap_or(Vec3::Y);
-        let (centre, radius) = match self.tree.bounds() {
-            Some((lo, hi)) => (0.5 * (lo + hi), (0.5 * (hi - lo)).length().max(0.05)),
-            None => (Vec3::ZERO, 1.0),
-        };
-        let light_clip_from_world = sun_clip_from_world(sun, centre, radius);
+        let (centre, radius) = self.tree_sphere();
         let ground = view.ground.unwrap_or_default();
         let normal = ground.normal.try_normalize().unwrap_or(Vec3::Y);
         let u = normal.any_orthonormal_vector();
@@ -415,6 +504,16 @@ impl Renderer {
         // The ground quad is centred under the tree and reaches well past its shadow.
         let origin = centre - normal * normal.dot(centre - ground.point);
         let extent = radius * 3.0;
+        // The shadow catcher adds nothing where no shadow can fall: it draws the ground the
+        // shadow map covers, or the whole ground disc where that is smaller (a low sun).
+        let disc = GroundPatch {
+            centre: origin,
+            half_a: u * extent,
+            half_b: v * extent,
+        };
+        let catcher = shadow_footprint(sun, centre, radius, ground.point, normal)
+            .filter(|patch| patch.area_m2() < disc.area_m2())
+            .unwrap_or(disc);
         let k = &self.background.intrinsics;
         let (brush, brush_radius) = view.debug.brush.unwrap_or((Vec3::ZERO, 0.0));
         let show_image = view.show_camera_image && self.has_camera_image;
@@ -444,42 +543,11 @@ impl Renderer {
             viewport: region,
             misc: [3.0, texel, 1.5, 0.0],
             fruit_color: Vec3::from(self.tree.fruit_color()).extend(1.0).to_array(),
+            catcher_centre: catcher.centre.extend(0.0).to_array(),
+            catcher_a: catcher.half_a.extend(0.0).to_array(),
+            catcher_b: catcher.half_b.extend(0.0).to_array(),
         }
     }
-}
-
-/// Orthographic view of the tree's bounding sphere from the sun (depth 0..1).
-fn sun_clip_from_world(sun: Vec3, centre: Vec3, radius: f32) -> Mat4 {
-    let eye = centre + sun * radius * 2.0;
-    let up = if sun.y.abs() > 0.99 { Vec3::Z } else { Vec3::Y };
-    let view = light_from_world(eye, centre, up);
-    let r = radius * 1.05;
-    orthographic(r, radius * 0.5, radius * 4.0) * view
-}
-
-/// Right-handed view (looking down −Z) from `eye` towards `target`.
-fn light_from_world(eye: Vec3, target: Vec3, up: Vec3) -> Mat4 {
-    let f = (target - eye).normalize_or(Vec3::NEG_Y);
-    let s = f.cross(up).normalize_or(Vec3::X);
-    let u = s.cross(f);
-    Mat4::from_cols(
-        Vec4::new(s.x, u.x, -f.x, 0.0),
-        Vec4::new(s.y, u.y, -f.y, 0.0),
-        Vec4::new(s.z, u.z, -f.z, 0.0),
-        Vec4::new(-s.dot(eye), -u.dot(eye), f.dot(eye), 1.0),
-    )
-}
-
-/// Orthographic projection of the box |x|, |y| ≤ `half` between `near` and `far` in front of
-/// the view, to wgpu clip space (depth 0..1).
-fn orthographic(half: f32, near: f32, far: f32) -> Mat4 {
-    let depth = 1.0 / (near - far);
-    Mat4::from_cols(
-        Vec4::new(1.0 / half, 0.0, 0.0, 0.0),
-        Vec4::new(0.0, 1.0 / half, 0.0, 0.0),
-        Vec4::new(0.0, 0.0, depth, 0.0),
-        Vec4::new(0.0, 0.0, depth * near, 1.0),
-    )
 }
 
 /// `size` scaled down (aspect kept, each side at least 1) so that neither side exceeds
@@ -573,22 +641,5 @@ mod tests {
         assert_eq!(fit_within((17000, 1000), 16384), (16384, 964));
         assert_eq!(fit_within((3000, 40000), 8192), (614, 8192));
         assert_eq!(fit_within((u32::MAX, 1), 4096), (4096, 1));
-    }
-
-    #[test]
-    fn the_sun_view_contains_the_tree_bounds() {
-        let m = sun_clip_from_world(Vec3::new(0.3, 0.9, 0.2).normalize(), Vec3::Y, 1.0);
-        for p in [
-            Vec3::ZERO,
-            Vec3::new(0.0, 2.0, 0.0),
-            Vec3::new(0.6, 1.0, -0.6),
-        ] {
-            let c = m * Vec4::from((p, 1.0));
-            let n = c.truncate() / c.w;
-            assert!(
-                n.x.abs() <= 1.0 && n.y.abs() <= 1.0 && (0.0..=1.0).contains(&n.z),
-                "{p} -> {n}"
-            );
-        }
     }
 }

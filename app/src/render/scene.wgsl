@@ -28,6 +28,11 @@ struct Globals {
     misc: vec4<f32>,
     // rgb: linear colour of the tree's fruit; w unused.
     fruit_color: vec4<f32>,
+    // The ground the shadow catcher draws (where the shadow map can shade it, or the whole
+    // ground disc if smaller): centre and half axes, xyz; w unused.
+    catcher_centre: vec4<f32>,
+    catcher_a: vec4<f32>,
+    catcher_b: vec4<f32>,
 }
 
 @group(0) @binding(0) var<uniform> g: Globals;
@@ -180,6 +185,17 @@ fn fs_card(v: LitOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f
     return vec4<f32>(shade_leaf(texel.rgb, v.normal, front, v.world, v.ambient), alpha);
 }
 
+// One sample a pixel (a CPU rasteriser): the blade's edge by an alpha test on the same sharpened
+// alpha, no coverage to blend it.
+@fragment
+fn fs_card_tested(v: LitOut, @builtin(front_facing) front: bool) -> @location(0) vec4<f32> {
+    let texel = textureSample(card_texture, tree_sampler, v.uv);
+    if (sharpened_alpha(texel.a) < 0.5) {
+        discard;
+    }
+    return vec4<f32>(shade_leaf(texel.rgb, v.normal, front, v.world, v.ambient), 1.0);
+}
+
 // ---- shadow map (depth only, from the sun) ----
 
 struct ShadowOut {
@@ -274,6 +290,15 @@ fn fs_wire(s: PositionOut) -> @location(0) vec4<f32> {
 
 // ---- ground plane: a shadow catcher over the camera image, or a lawn outside AR ----
 
+// Corner `i` of a quad of two triangles over [-1, 1]².
+fn quad_corner(i: u32) -> vec2<f32> {
+    var corners = array<vec2<f32>, 6>(
+        vec2<f32>(-1.0, -1.0), vec2<f32>(1.0, -1.0), vec2<f32>(1.0, 1.0),
+        vec2<f32>(-1.0, -1.0), vec2<f32>(1.0, 1.0), vec2<f32>(-1.0, 1.0),
+    );
+    return corners[i];
+}
+
 struct GroundOut {
     @builtin(position) clip: vec4<f32>,
     @location(0) world: vec3<f32>,
@@ -282,11 +307,7 @@ struct GroundOut {
 
 @vertex
 fn vs_ground(@builtin(vertex_index) i: u32) -> GroundOut {
-    var corners = array<vec2<f32>, 6>(
-        vec2<f32>(-1.0, -1.0), vec2<f32>(1.0, -1.0), vec2<f32>(1.0, 1.0),
-        vec2<f32>(-1.0, -1.0), vec2<f32>(1.0, 1.0), vec2<f32>(-1.0, 1.0),
-    );
-    let c = corners[i];
+    let c = quad_corner(i);
     let normal = normalize(cross(g.ground_v.xyz, g.ground_u.xyz));
     // Lifted 5 mm so the shadow wins the depth test against the scene's own ground triangles.
     let world = g.ground_origin.xyz + (g.ground_u.xyz * c.x + g.ground_v.xyz * c.y) * g.ground_origin.w
@@ -295,6 +316,22 @@ fn vs_ground(@builtin(vertex_index) i: u32) -> GroundOut {
     out.clip = g.clip_from_world * vec4<f32>(world, 1.0);
     out.world = world;
     out.local = c;
+    return out;
+}
+
+// The shadow catcher's quad: only the ground the shadow can fall on (see `catcher_centre`), with
+// the ground disc's own coordinates for the fade at its rim.
+@vertex
+fn vs_ground_shadow(@builtin(vertex_index) i: u32) -> GroundOut {
+    let c = quad_corner(i);
+    let normal = normalize(cross(g.ground_v.xyz, g.ground_u.xyz));
+    let on_ground = g.catcher_centre.xyz + g.catcher_a.xyz * c.x + g.catcher_b.xyz * c.y;
+    let world = on_ground + normal * 0.005;
+    let d = on_ground - g.ground_origin.xyz;
+    var out: GroundOut;
+    out.clip = g.clip_from_world * vec4<f32>(world, 1.0);
+    out.world = world;
+    out.local = vec2<f32>(dot(d, g.ground_u.xyz), dot(d, g.ground_v.xyz)) / g.ground_origin.w;
     return out;
 }
 
@@ -317,12 +354,8 @@ fn fs_ground_lawn(s: GroundOut) -> @location(0) vec4<f32> {
 
 @vertex
 fn vs_points(@builtin(vertex_index) i: u32, @location(0) position: vec3<f32>) -> PositionOut {
-    var corners = array<vec2<f32>, 6>(
-        vec2<f32>(-1.0, -1.0), vec2<f32>(1.0, -1.0), vec2<f32>(1.0, 1.0),
-        vec2<f32>(-1.0, -1.0), vec2<f32>(1.0, 1.0), vec2<f32>(-1.0, 1.0),
-    );
     var clip = g.clip_from_world * vec4<f32>(position, 1.0);
-    let offset = corners[i] * g.misc.x / g.viewport.zw;
+    let offset = quad_corner(i) * g.misc.x / g.viewport.zw;
     clip = vec4<f32>(clip.xy + offset * clip.w, clip.zw);
     var out: PositionOut;
     out.clip = clip;
