@@ -33,6 +33,10 @@ pub struct GrowArgs {
     /// Also export the tree's meshes (three levels of detail, leaves, textures) as binary glTF 2.0.
     #[arg(long)]
     pub glb: Option<PathBuf>,
+    /// Write the `--glb` file for readers without `EXT_mesh_gpu_instancing` and `MSFT_lod`
+    /// (Blender 3.4): the finest level only, its leaf cards as plain triangles.
+    #[arg(long, requires = "glb")]
+    pub glb_compat: bool,
     /// Also export the finest level of detail as Wavefront OBJ + MTL, textures next to it.
     #[arg(long)]
     pub obj: Option<PathBuf>,
@@ -117,7 +121,13 @@ pub fn grow(args: GrowArgs) -> anyhow::Result<()> {
     let elapsed_ms = started.elapsed().as_secs_f64() * 1000.0;
     let cpu_ms = process_cpu_ms() - cpu_started;
     tree.save_as(&args.out, args.format.into())?;
-    export_meshes(&tree, args.season, args.glb.as_deref(), args.obj.as_deref())?;
+    let glb_options = if args.glb_compat {
+        sylva_core::export::GlbOptions::compat()
+    } else {
+        sylva_core::export::GlbOptions::default()
+    };
+    let glb = args.glb.as_deref().map(|path| (path, glb_options));
+    export_meshes(&tree, args.season, glb, args.obj.as_deref())?;
     let m = tree.metrics();
     println!(
         "internodes={} height_m={:.3} crown_width_m={:.3} trunk_diameter_m={:.4} elapsed_ms={:.1} cpu_ms={:.1} threads={}",
@@ -176,7 +186,7 @@ fn check_grow_files(args: &GrowArgs) -> anyhow::Result<()> {
 fn export_meshes(
     tree: &Tree,
     season: Season,
-    glb: Option<&Path>,
+    glb: Option<(&Path, sylva_core::export::GlbOptions)>,
     obj: Option<&Path>,
 ) -> anyhow::Result<()> {
     if glb.is_none() && obj.is_none() {
@@ -185,8 +195,8 @@ fn export_meshes(
     let meshes = sylva_core::geometry::build_tree_meshes_in(tree, season);
     let triangles = [0, 1, 2].map(|lod| meshes.num_triangles(lod));
     let leaves = meshes.leaves.indices.len() / 6;
-    if let Some(path) = glb {
-        sylva_core::export::write_glb(&meshes, path)?;
+    if let Some((path, options)) = glb {
+        sylva_core::export::write_glb_with(&meshes, path, options)?;
         println!(
             "glb={} season={season} leaves={leaves} lod_triangles={triangles:?}",
             path.display()

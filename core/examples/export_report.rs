@@ -3,11 +3,15 @@
 //! triangles times its instances), the coarsest level's share of them and how far its side
 //! silhouette departs from LOD0's (`geometry::lod_silhouette`).
 //!
+//! The `compat MB` column is the same tree written for readers without
+//! `EXT_mesh_gpu_instancing` and `MSFT_lod` (`GlbOptions::compat`: LOD0 only, cards as plain
+//! triangles; Blender 3.4's importer).
+//!
 //! `cargo run --release -p sylva-core --example export_report [age_years] [seed] [dir]`: with
-//! `dir`, the files are written there too (`<preset>.glb`).
+//! `dir`, the files are written there too (`<preset>.glb`, `<preset>.compat.glb`).
 
 use sylva_core::Tree;
-use sylva_core::export::glb_bytes;
+use sylva_core::export::{GlbOptions, glb_bytes, glb_bytes_with};
 use sylva_core::geometry::build_tree_meshes;
 use sylva_core::geometry::silhouette::side_silhouette_difference;
 use sylva_core::species::Species;
@@ -19,8 +23,16 @@ fn main() {
     let dir = args.next().map(std::path::PathBuf::from);
     println!("{age_years}-year trees, seed {seed}");
     println!(
-        "{:<16} {:>8} {:>10} {:>10} {:>10} {:>9} {:>9} {:>10}",
-        "preset", "glb MB", "LOD0 tris", "own", "instanced", "cards", "coarsest", "silhouette"
+        "{:<16} {:>8} {:>9} {:>10} {:>10} {:>10} {:>9} {:>9} {:>10}",
+        "preset",
+        "glb MB",
+        "compat MB",
+        "LOD0 tris",
+        "own",
+        "instanced",
+        "cards",
+        "coarsest",
+        "silhouette"
     );
     for species in Species::presets() {
         let name = species.name.clone();
@@ -39,19 +51,32 @@ fn main() {
                 continue;
             }
         };
+        let compat = match glb_bytes_with(&meshes, GlbOptions::compat()) {
+            Ok(compat) => compat,
+            Err(e) => {
+                println!("{name:<16} cannot export without instancing: {e}");
+                continue;
+            }
+        };
         if let Some(dir) = &dir {
-            let path = dir.join(format!("{name}.glb"));
-            if let Err(e) = std::fs::write(&path, &glb) {
-                println!("{name:<16} cannot write {}: {e}", path.display());
+            for (file, bytes) in [
+                (format!("{name}.glb"), &glb),
+                (format!("{name}.compat.glb"), &compat),
+            ] {
+                let path = dir.join(file);
+                if let Err(e) = std::fs::write(&path, bytes) {
+                    println!("{name:<16} cannot write {}: {e}", path.display());
+                }
             }
         }
         let bytes = glb.len() as f64 * 1e-6;
         let silhouette = side_silhouette_difference(&meshes, coarsest)
             .map_or("-".to_string(), |d| format!("{:.1}%", 100.0 * d));
         println!(
-            "{:<16} {:>8.2} {:>10} {:>10} {:>10} {:>9} {:>8.1}% {:>10}",
+            "{:<16} {:>8.2} {:>9.2} {:>10} {:>10} {:>10} {:>9} {:>8.1}% {:>10}",
             name,
             bytes,
+            compat.len() as f64 * 1e-6,
             total,
             total - instanced,
             instanced,

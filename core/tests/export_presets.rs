@@ -5,7 +5,7 @@
 mod support;
 
 use sylva_core::Tree;
-use sylva_core::export::write_glb;
+use sylva_core::export::{GlbOptions, write_glb, write_glb_with};
 use sylva_core::geometry::{LOD_TRIANGLE_FRACTIONS, build_tree_meshes, mesh_params_for};
 use sylva_core::species::Species;
 
@@ -115,6 +115,50 @@ fn every_preset_at_40_years_exports_a_valid_glb_within_15_mb_and_600k_triangles(
         if report.num_errors + report.num_warnings > 0 {
             failures.push(format!("{name}: validator: {}", report.text));
         }
+        failures.extend(compat_failures(&name, &meshes, dir.path()));
     }
     assert!(failures.is_empty(), "{}", failures.join("\n"));
+}
+
+/// What is wrong with the `--glb-compat` file of `meshes` (for Blender 3.4, which refuses
+/// `EXT_mesh_gpu_instancing` and stacks `MSFT_lod` levels): it must pass the validator, need
+/// neither extension, and draw LOD0's triangles as one tree with no other level.
+fn compat_failures(
+    name: &str,
+    meshes: &sylva_core::geometry::TreeMeshes,
+    dir: &std::path::Path,
+) -> Vec<String> {
+    let path = dir.join(format!("{name}.compat.glb"));
+    write_glb_with(meshes, &path, GlbOptions::compat()).unwrap_or_else(|e| panic!("{name}: {e}"));
+    let bytes = std::fs::metadata(&path).expect("written").len();
+    let report = support::validate_glb(&path);
+    let read = support::read_glb_with_gltf_transform(&path);
+    let (json, _) = support::glb_chunks(&path);
+    let used = json["extensionsUsed"].to_string();
+    println!(
+        "{name}: compat {:.2} MB, extensions {used}, validator {} errors {} warnings",
+        bytes as f64 * 1e-6,
+        report.num_errors,
+        report.num_warnings
+    );
+    let mut failures = Vec::new();
+    if report.num_errors + report.num_warnings > 0 {
+        failures.push(format!("{name}: compat validator: {}", report.text));
+    }
+    for extension in ["EXT_mesh_gpu_instancing", "MSFT_lod"] {
+        if used.contains(extension) {
+            failures.push(format!("{name}: compat file uses {extension}"));
+        }
+    }
+    let nodes = json["nodes"].as_array().map_or(0, Vec::len);
+    let levels = read["levels"].as_array().map_or(0, Vec::len);
+    let drawn = read["levels"][0]["drawn_triangles"].as_u64();
+    if nodes != 1 || levels != 1 || drawn != Some(meshes.num_triangles(0) as u64) {
+        failures.push(format!(
+            "{name}: compat file has {nodes} nodes, {levels} levels, {drawn:?} triangles \
+             for LOD0's {}",
+            meshes.num_triangles(0)
+        ));
+    }
+    failures
 }

@@ -171,55 +171,72 @@ fn no_leaf_or_fruit_of_a_40_year_weeping_willow_or_oak_is_below_the_ground() {
     }
 }
 
-/// The coarsest level of every preset at 30 years: its triangles over the finest level's, its
-/// blade area over the finest level's, how far its filtered side view departs from the finest
-/// level's, and the same for the coarse level as it was before cards merged (the same prefix
-/// of the finest level's cards, unscaled).
-fn coarsest_levels() -> Vec<(String, f32, f32, f32, f32)> {
-    let mut out = Vec::new();
-    for species in Species::presets() {
-        let name = species.name.clone();
-        let mut tree = Tree::new(species, SEED);
-        tree.grow_years(30.0);
-        let meshes = build_tree_meshes(&tree);
-        let coarsest = meshes.lods.len() - 1;
-        let triangles = meshes.num_triangles(coarsest) as f32 / meshes.num_triangles(0) as f32;
-        let area = |m: &sylva_core::geometry::TreeMeshes, lod: usize| {
-            let level = &m.lods[lod];
-            leaf_card_area_m2(level.leaves_in(&m.leaves), level.num_leaf_indices)
-        };
-        let blade = area(&meshes, coarsest) / area(&meshes, 0);
-        // The side views filtered as a renderer shows a tree 100 pixels tall.
-        let difference = |m: &sylva_core::geometry::TreeMeshes| {
-            side_silhouette_difference(m, coarsest).expect("a side view")
-        };
-        let mut dropped = meshes.clone();
-        dropped.lods[coarsest].merged_leaves = meshes.leaves.clone();
-        let merged_difference = difference(&meshes);
-        let dropped_difference = difference(&dropped);
-        println!(
-            "{name}: LOD{coarsest} {:.1}% of the triangles, {:.1}% of the blade area; side view \
-             differs by {:.1}% (dropping cards instead: {:.1}%)",
-            100.0 * triangles,
-            100.0 * blade,
-            100.0 * merged_difference,
-            100.0 * dropped_difference
-        );
-        out.push((
-            name,
-            triangles,
-            blade,
-            merged_difference,
-            dropped_difference,
-        ));
-    }
-    out
+/// Ages at which the coarsest level of detail is compared with the finest (issue #25).
+const LOD_AGES_YEARS: [f32; 2] = [15.0, 40.0];
+
+/// A preset at an age; its coarsest level's triangle share, card area share, side view
+/// difference, and the side view difference with the cards unmerged.
+type CoarsestLevel = (String, f32, f32, f32, f32);
+
+/// The coarsest level of every preset at each of [`LOD_AGES_YEARS`]: its triangles over the
+/// finest level's, its card area over the finest level's, how far its filtered side view
+/// departs from the finest level's, and the same for the coarse level's cards unmerged (as
+/// many of the finest level's cards, unscaled), grown once for both tests.
+fn coarsest_levels() -> &'static [CoarsestLevel] {
+    static LEVELS: OnceLock<Vec<CoarsestLevel>> = OnceLock::new();
+    LEVELS.get_or_init(|| {
+        Species::presets()
+            .into_iter()
+            .flat_map(|species| {
+                let mut tree = Tree::new(species, SEED);
+                LOD_AGES_YEARS.map(|age| {
+                    tree.grow_years(age - tree.age_years());
+                    coarsest_level(&tree)
+                })
+            })
+            .collect()
+    })
+}
+
+fn coarsest_level(tree: &Tree) -> CoarsestLevel {
+    let name = format!("{} at {} years", tree.species.name, tree.age_years());
+    let meshes = build_tree_meshes(tree);
+    let coarsest = meshes.lods.len() - 1;
+    let triangles = meshes.num_triangles(coarsest) as f32 / meshes.num_triangles(0) as f32;
+    let area = |m: &sylva_core::geometry::TreeMeshes, lod: usize| {
+        let level = &m.lods[lod];
+        leaf_card_area_m2(level.leaves_in(&m.leaves), level.num_leaf_indices)
+    };
+    let blade = area(&meshes, coarsest) / area(&meshes, 0);
+    // The side views filtered as a renderer shows a tree 100 pixels tall.
+    let difference = |m: &sylva_core::geometry::TreeMeshes| {
+        side_silhouette_difference(m, coarsest).expect("a side view")
+    };
+    let mut dropped = meshes.clone();
+    dropped.lods[coarsest].merged_leaves = meshes.leaves.clone();
+    let merged_difference = difference(&meshes);
+    let dropped_difference = difference(&dropped);
+    println!(
+        "{name}: LOD{coarsest} {:.1}% of the triangles, {:.1}% of the card area; side view \
+         differs by {:.1}% (cards unmerged: {:.1}%)",
+        100.0 * triangles,
+        100.0 * blade,
+        100.0 * merged_difference,
+        100.0 * dropped_difference
+    );
+    (
+        name,
+        triangles,
+        blade,
+        merged_difference,
+        dropped_difference,
+    )
 }
 
 #[test]
 fn the_coarsest_level_merges_cards_keeping_the_leaf_area_at_15_percent_of_the_triangles() {
     let mut failures = Vec::new();
-    for (name, triangles, blade, merged, dropped) in coarsest_levels() {
+    for &(ref name, triangles, blade, merged, dropped) in coarsest_levels() {
         if triangles > 0.15 + 1e-3 {
             failures.push(format!(
                 "{name}: {:.1}% of the triangles",
@@ -242,11 +259,11 @@ fn the_coarsest_level_merges_cards_keeping_the_leaf_area_at_15_percent_of_the_tr
 
 #[test]
 #[ignore = "issue #25 open: the coarsest level's filtered side view differs from the finest's \
-            by 14–24% (willow, oak … spruce), not at most 10%"]
+            by 8.8% (willow at 40 years) to 23.6% (poplar at 15), not at most 10%"]
 fn the_coarsest_level_keeps_the_side_silhouette_within_10_percent() {
     let failures: Vec<String> = coarsest_levels()
-        .into_iter()
-        .filter(|&(_, _, _, merged, _)| merged > 0.10)
+        .iter()
+        .filter(|&&(_, _, _, merged, _)| merged > 0.10)
         .map(|(name, _, _, merged, _)| format!("{name}: differs by {:.1}%", 100.0 * merged))
         .collect();
     assert!(failures.is_empty(), "{}", failures.join("\n"));

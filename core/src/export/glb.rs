@@ -8,7 +8,7 @@ use json::validation::{Checked::Valid, USize64};
 
 use super::leaf_instances::{CardKind, EXT_MESH_GPU_INSTANCING, card_instances, common_scale};
 use super::quantize::{self, Quantizer, UvBox};
-use super::{ExportError, TEXTURE_SIZE, ambient_color};
+use super::{ExportError, GlbOptions, TEXTURE_SIZE, ambient_color};
 use crate::geometry::leaf_card::card_texture;
 use crate::geometry::textures::{bark_texture, png_bytes};
 use crate::geometry::{TreeMesh, TreeMeshes};
@@ -26,13 +26,27 @@ pub(super) const CHUNK_BIN: u32 = 0x004E_4942;
 
 /// Writes `meshes` to `path` as binary glTF 2.0.
 pub fn write_glb(meshes: &TreeMeshes, path: &Path) -> Result<(), ExportError> {
-    let bytes = build(meshes, path)?;
+    write_glb_with(meshes, path, GlbOptions::default())
+}
+
+/// [`write_glb`] with `options`.
+pub fn write_glb_with(
+    meshes: &TreeMeshes,
+    path: &Path,
+    options: GlbOptions,
+) -> Result<(), ExportError> {
+    let bytes = build(meshes, path, options)?;
     crate::safe_write::write_file(path, &bytes).map_err(ExportError::io(path))
 }
 
 /// `meshes` as the bytes of a binary glTF 2.0 file.
 pub fn glb_bytes(meshes: &TreeMeshes) -> Result<Vec<u8>, ExportError> {
-    build(meshes, Path::new("<memory>"))
+    glb_bytes_with(meshes, GlbOptions::default())
+}
+
+/// [`glb_bytes`] with `options`.
+pub fn glb_bytes_with(meshes: &TreeMeshes, options: GlbOptions) -> Result<Vec<u8>, ExportError> {
+    build(meshes, Path::new("<memory>"), options)
 }
 
 /// Buffer views of one mesh's quantized vertex attributes, which the primitives drawing parts
@@ -417,7 +431,7 @@ pub(super) fn f32_bytes<'a>(values: impl Iterator<Item = &'a f32>) -> Vec<u8> {
     values.flat_map(|v| v.to_le_bytes()).collect()
 }
 
-fn build(meshes: &TreeMeshes, path: &Path) -> Result<Vec<u8>, ExportError> {
+fn build(meshes: &TreeMeshes, path: &Path, options: GlbOptions) -> Result<Vec<u8>, ExportError> {
     if meshes.lods.iter().all(|lod| lod.num_triangles() == 0) {
         return Err(ExportError::Empty {
             path: path.to_path_buf(),
@@ -451,12 +465,18 @@ fn build(meshes: &TreeMeshes, path: &Path) -> Result<Vec<u8>, ExportError> {
         0.95,
         false,
     );
+    let leaf_uv_box = (!options.instanced_leaves).then(|| {
+        let merged = meshes.lods.iter().flat_map(|lod| &lod.merged_leaves.uvs);
+        UvBox::of(meshes.leaves.uvs.iter().chain(merged))
+    });
     let leaf = if meshes.leaves.is_empty() {
         None
     } else {
         let leaf_png = builder.png("leaf texture", &card_texture(meshes, TEXTURE_SIZE))?;
         let texture = builder.texture("leaf", &leaf_png, json::texture::WrappingMode::ClampToEdge);
-        Some(builder.material("leaf", Some(texture), None, [1.0; 4], 0.6, true))
+        // Plain cards carry quantized texture coordinates; the card meshes carry their own.
+        let uv_box = leaf_uv_box.as_ref().filter(|_| !options.instanced_leaves);
+        Some(builder.material("leaf", Some(texture), uv_box, [1.0; 4], 0.6, true))
     };
     let fruit = if meshes.fruit.is_empty() {
         None
@@ -478,7 +498,12 @@ fn build(meshes: &TreeMeshes, path: &Path) -> Result<Vec<u8>, ExportError> {
     let card_size = (meshes.leaf_card.width_m, meshes.leaf_card.length_m);
     let mut card_meshes: Vec<(CardKind, Option<[u32; 3]>, json::Index<json::Mesh>)> = Vec::new();
     let mut level_nodes = Vec::new();
-    for (level, lod) in meshes.lods.iter().enumerate() {
+    let num_levels = if options.coarse_levels {
+        meshes.lods.len()
+    } else {
+        1
+    };
+    for (level, lod) in meshes.lods.iter().enumerate().take(num_levels) {
         let mut primitives = Vec::new();
         if !lod.branches.is_empty() {
             let branches = &lod.branches;
@@ -495,7 +520,13 @@ fn build(meshes: &TreeMeshes, path: &Path) -> Result<Vec<u8>, ExportError> {
             ));
         }
         let mut children = Vec::new();
-        if let Some(material) = leaf.filter(|_| lod.num_leaf_indices > 0) {
+        let plain_leaves = leaf_uv_box.as_ref().zip(leaf);
+        if let Some((uv_box, material)) = plain_leaves.filter(|_| lod.num_leaf_indices > 0) {
+            let cards = lod.leaves_in(&meshes.leaves);
+            let num_vertices = cards.num_vertices_of_prefix(lod.num_leaf_indices);
+            let views = builder.vertex_views(cards, num_vertices, Some(uv_box), &quantizer);
+            primitives.extend(builder.primitives(cards, &views, lod.num_leaf_indices, material));
+        } else if let Some(material) = leaf.filter(|_| lod.num_leaf_indices > 0) {
             let cards = lod.leaves_in(&meshes.leaves);
             let groups = card_instances(cards, lod.num_leaf_indices, card_size, &quantizer);
             for (kind, instances) in groups {

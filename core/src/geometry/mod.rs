@@ -20,11 +20,13 @@
 //! - **Fruit** grows on buds with p = r·L² above a threshold (appendix C.2).
 //! - **Ambient**: every vertex carries the ambient light of the growth shadow grid, sampled
 //!   through a callback so this module does not depend on growth.
-//! - **Levels of detail** ([`Lod`]): about 100%, 40% and 15% of the triangles, by fewer sides,
-//!   dropping the thinnest branches, and merging leaf cards: a coarse level with a fraction f
-//!   of the cards merges runs of 1/f neighbouring cards (along a Morton curve) into one card
-//!   each, holding their area ([`lod_leaves`]), so the leaf area stays and the silhouette
-//!   mostly does ([`silhouette`] measures how far it departs).
+//! - **Levels of detail** ([`Lod`]): 100%, 40% and 15% of the triangles (bark, cards and fruit
+//!   together). A coarse level with fraction f draws √f of the sides on the thickest branches
+//!   within f^1.5 of the bark's triangles (the trunk and main limbs; the thin inner wood goes)
+//!   and gives the leaf cards the rest of its triangles: its n cards merge runs of
+//!   neighbouring cards (along a Morton curve) into one card each, holding their area
+//!   ([`lod_leaves`]), so the leaf area stays and the silhouette mostly does ([`silhouette`]
+//!   measures how far it departs).
 //!
 //! Building: [`build_meshes`] makes every level (export, LOD switching); [`build_level`] makes
 //! only the level a renderer draws, plus the whole leaf and fruit buffers; a [`Mesher`] kept
