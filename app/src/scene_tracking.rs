@@ -85,7 +85,6 @@ impl SceneMesher {
                 ground.normal,
             );
             self.solids.append_mesh(
-                ground.point,
                 ground.normal,
                 &mut occluder.positions,
                 &mut occluder.indices,

@@ -36,11 +36,15 @@ const GROW_FRAMES: [usize; 8] = [40, 60, 80, 100, 120, 140, 160, 180];
 const EVAL_FRAMES: std::ops::RangeInclusive<usize> = 120..=235;
 /// What holds with the solids on the ground (measured 2026-12-01: 93.8% of 245 465 tree pixels
 /// right, 93.8% where the true solids cover, 99.4% of the 25 802 behind them hidden; 92.9%,
-/// 92.9% and 99.1% on 2026-12-02 with the species' leaf cards drawn, a fuller crown); issue 20
-/// asks 95% right, not met: the solids' hulls stand out of the box by up to 15 cm where tracked
-/// points at its silhouette were triangulated off it, and hide the tree there.
-const MIN_RIGHT: f64 = 0.92;
-const MIN_COVERED_RIGHT: f64 = 0.92;
+/// 92.9% and 99.1% on 2026-12-02 with the species' leaf cards drawn, a fuller crown; 93.4%,
+/// 93.4% and 98.3% once the solids are carved by the free rays of the tracked points). Issue
+/// 20 asks 95% right, not met: the box's right half has no tracked point (its points are on its
+/// left face and top edge), so its solid reaches there through tracks triangulated off its
+/// silhouette, which no free ray crosses; and the wall's solid starts about 15 cm in front of
+/// the true wall. The errors are in the solids, not the frame's depth mesh: drawn with the
+/// solids alone, 93.9% right and 97.7% hidden (`SYLVA_OCCLUSION_DIR` draws the wrong pixels).
+const MIN_RIGHT: f64 = 0.93;
+const MIN_COVERED_RIGHT: f64 = 0.93;
 const MIN_HIDDEN_RIGHT: f64 = 0.98;
 
 /// The generator's solids as closed triangle meshes, in the tracked world.
@@ -161,6 +165,21 @@ fn the_tracked_occluder_hides_a_tree_planted_behind_the_box_where_the_true_box_d
         let tree_px = differs(&images[0], &empty);
         let true_px = differs(&images[1], &empty);
         let app_px = differs(&images[2], &empty);
+        if let Some(dir) = std::env::var_os("SYLVA_OCCLUSION_DIR") {
+            // Green: right where the true solids hide or show the tree; red: hidden by the
+            // app's occluder only; blue: shown by it only.
+            let errors = image::RgbaImage::from_fn(width, height, |x, y| {
+                let i = (y * width + x) as usize;
+                image::Rgba(match (tree_px[i], true_px[i], app_px[i]) {
+                    (false, ..) => [0, 0, 0, 255],
+                    (true, a, b) if a == b => [0, 140, 0, 255],
+                    (true, true, false) => [255, 0, 0, 255],
+                    (true, ..) => [0, 80, 255, 255],
+                })
+            });
+            let path = Path::new(&dir).join(format!("frame_{step:04}_errors.png"));
+            errors.save(&path).expect("write image");
+        }
         let pixel_camera = world_camera.intrinsics.scaled_to(width, height);
         let (mut right, mut n, mut hidden, mut hidden_right) = (0, 0, 0, 0);
         for i in 0..tree_px.len() {

@@ -20,8 +20,9 @@
 //! within centimetres.
 //!
 //! **Solids on the ground.** [`GroundSolids`] keeps every tracked point in the world over the
-//! frames and raises the groups of points above the ground into prisms standing on it: the
-//! faces of plain objects, where one frame tracks too few points, still occlude.
+//! frames and raises the groups of points above the ground into prisms standing on it, carved
+//! by the free space seen along the rays to the other points: the faces of plain objects, where
+//! one frame tracks too few points, still occlude.
 //!
 //! **Spaces.** Pixels: the tracker's undistorted pixel coordinates (`u` right, `v` down).
 //! Camera space: OpenCV (X right, Y down, Z forward), metres;
@@ -32,6 +33,7 @@ mod export;
 mod ground_solids;
 mod layer;
 mod mesh;
+mod plan;
 mod query;
 mod validity;
 
