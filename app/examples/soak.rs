@@ -140,7 +140,11 @@ fn main() {
         held as f64 / tree_bytes.max(1) as f64,
         resident as f64 / tree_bytes.max(1) as f64,
     );
-    println!("peak_heap_ratio={peak_ratio:.2}");
+    println!(
+        "peak_heap_ratio={peak_ratio:.2} tree_model_own_mib={:.2} tree_saved_state_mib={:.2}",
+        mib(design.tree.own_bytes()),
+        mib(design.tree.saved_state_bytes())
+    );
 }
 
 /// The final tree's own size: the heap of a whole copy of it (shadow grid included).

@@ -367,11 +367,12 @@ fn planted(species: Species, seed: u64) -> Tree {
 const MAX_UNDO: usize = 64;
 /// Memory of the undo steps and of the timeline, each in multiples of the tree's own size
 /// (`Tree::own_bytes`; the oldest dropped, or thinned, beyond it), so the design stays within a
-/// few times the tree's size however long it is edited (see `examples/soak.rs`). The undo
-/// budget keeps several whole-tree steps of a large tree (at 0.75 only about two were left,
-/// too few to take back a years change and the edits before it); snapshots are whole compact
-/// trees, so a smaller bound needs undo steps stored as differences.
-const UNDO_BUDGET_TREES: f32 = 4.0;
+/// few times the tree's size however long it is edited (see `examples/soak.rs`). Undo steps are
+/// differences (what each operation changed): a stroke or a grow costs a few percent of the
+/// tree, a years change or a prune up to the internodes it adds or removes, about a tree; two
+/// trees keep such a step with the dozens of edits around it (at one tree, a years change forth
+/// and back dropped the step before it).
+const UNDO_BUDGET_TREES: f32 = 2.0;
 /// Finished strokes kept (oldest dropped).
 const MAX_FINISHED_STROKES: usize = 16;
 const TIMELINE_BUDGET_TREES: f32 = 0.75;
@@ -831,7 +832,10 @@ impl DesignState {
     }
 
     fn end_stroke(&mut self, keep: bool) {
-        self.brush = None;
+        if self.brush.take().is_some() {
+            // The stroke's undo step is complete: kept as what it changed.
+            self.history.finish(&self.tree);
+        }
         if let Some(stroke) = self.stroke.take()
             && keep
             && !stroke.points.is_empty()

@@ -9,7 +9,11 @@
 //!
 //! Run: `XDG_RUNTIME_DIR=/tmp/sylva-xdg WGPU_BACKEND=vulkan cargo test --release -p sylva-app --test golden`
 
+mod golden_compare;
+
 use std::path::PathBuf;
+
+use golden_compare::{assert_matches_golden, differs};
 
 use glam::Vec3;
 use image::{Rgba, RgbaImage};
@@ -23,14 +27,8 @@ use sylva_core::Tree;
 use sylva_core::geometry::Season;
 use sylva_core::species::Species;
 
-const CHANNEL_TOLERANCE: u8 = 12;
-const MAX_DIFFERING_FRACTION: f64 = 0.005;
 const WIDTH: u32 = 320;
 const HEIGHT: u32 = 240;
-
-fn golden_dir() -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/golden")
-}
 
 struct Bench {
     gpu: Gpu,
@@ -66,63 +64,6 @@ impl Bench {
 
 fn grown_tree() -> TreeMesh {
     sylva_app::tree_model::golden_tree_mesh()
-}
-
-fn differs(a: &Rgba<u8>, b: &Rgba<u8>, tolerance: u8) -> bool {
-    a.0.iter()
-        .zip(b.0.iter())
-        .any(|(x, y)| x.abs_diff(*y) > tolerance)
-}
-
-/// Compares with the golden `name`.png under the stated tolerance.
-fn assert_matches_golden(name: &str, actual: &RgbaImage) {
-    let dir = golden_dir();
-    let path = dir.join(format!("{name}.png"));
-    if std::env::var_os("SYLVA_BLESS").is_some() {
-        std::fs::create_dir_all(path.parent().unwrap_or(&dir)).expect("golden dir");
-        actual.save(&path).expect("write golden");
-        return;
-    }
-    let expected = image::open(&path)
-        .unwrap_or_else(|e| {
-            panic!(
-                "golden {} unreadable ({e}); run with SYLVA_BLESS=1 to create it",
-                path.display()
-            )
-        })
-        .to_rgba8();
-    assert_eq!(
-        expected.dimensions(),
-        actual.dimensions(),
-        "{name}: size differs"
-    );
-    let mut difference = RgbaImage::new(actual.width(), actual.height());
-    let mut num_differing = 0usize;
-    for (x, y, a) in actual.enumerate_pixels() {
-        let e = expected.get_pixel(x, y);
-        if differs(a, e, CHANNEL_TOLERANCE) {
-            num_differing += 1;
-            difference.put_pixel(x, y, Rgba([255, 0, 0, 255]));
-        } else {
-            let l = a.0[0] / 3 + a.0[1] / 3 + a.0[2] / 3;
-            difference.put_pixel(x, y, Rgba([l, l, l, 255]));
-        }
-    }
-    let fraction = num_differing as f64 / (actual.width() * actual.height()) as f64;
-    if fraction > MAX_DIFFERING_FRACTION {
-        actual
-            .save(dir.join(format!("{name}-actual.png")))
-            .expect("write actual");
-        difference
-            .save(dir.join(format!("{name}-difference.png")))
-            .expect("write difference");
-        panic!(
-            "{name}: {num_differing} pixels ({:.3} %) differ by more than {CHANNEL_TOLERANCE}, allowed {:.3} %; see {name}-actual.png and {name}-difference.png in {}",
-            fraction * 100.0,
-            MAX_DIFFERING_FRACTION * 100.0,
-            dir.display()
-        );
-    }
 }
 
 fn num_pixels_unlike(image: &RgbaImage, colour: Rgba<u8>) -> usize {

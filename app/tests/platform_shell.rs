@@ -9,23 +9,22 @@
 //! Each records a session into app storage that `sylva replay` replays to the same tree and
 //! the same frames; and both paths design the same tree from the same footage and touches.
 
+mod phone_demo;
+
 use std::path::{Path, PathBuf};
 use std::process::Command;
 use std::time::{Duration, Instant};
 
-use glam::{DMat4, Vec2, Vec3};
+use glam::{Vec2, Vec3};
 use image::RgbaImage;
-use sylva_app::cmd_app::demo_sequence;
-use sylva_app::footage::Footage;
+use phone_demo::{demo_frames, top_pixel};
 use sylva_app::platform::{
-    DrawSurface, FeaturePoint, OffscreenSurface, PlatformFrame, PlatformIntrinsics, PlatformPlane,
-    PlatformTracking, ShellApp, StorageLocation, TouchInput, TrackerChoice,
+    DrawSurface, OffscreenSurface, ShellApp, StorageLocation, TouchInput, TrackerChoice,
 };
 use sylva_app::render::offscreen::Offscreen;
 use sylva_app::render::resources::letterbox;
 use sylva_app::render::{FrameView, Gpu, Renderer};
 use sylva_app::state::TouchPhase;
-use sylva_tracking::{FrameSource, SourceEvent, Tracker, TrackerConfig, TumSequence};
 
 /// Frames of the demo used (of 240).
 const NUM_FRAMES: usize = 240;
@@ -43,74 +42,6 @@ const PAUSE_AT_FRAME: usize = 150;
 /// Camera frames that arrive while the app is in the background (dropped).
 const FRAMES_WHILE_PAUSED: usize = 4;
 
-fn demo_intrinsics(sequence: &TumSequence) -> PlatformIntrinsics {
-    let c = sequence.camera;
-    PlatformIntrinsics {
-        width: c.width,
-        height: c.height,
-        fx: c.fx,
-        fy: c.fy,
-        cx: c.cx,
-        cy: c.cy,
-    }
-}
-
-/// The demo's frames as a phone camera hands them over; with `platform_tracking`, each with the
-/// pose, feature points and ground plane of Sylva's own tracker run on the images, as an AR
-/// session's tracking.
-fn demo_frames(platform_tracking: bool) -> (PlatformIntrinsics, Vec<PlatformFrame>) {
-    let root = demo_sequence().expect("the bundled demo sequence test-data/demo_garden");
-    let sequence = TumSequence::open(&root).expect("demo sequence");
-    let footage = Footage::open(&root).expect("demo footage");
-    let intrinsics = demo_intrinsics(&sequence);
-    sylva_tracking::cv::configure_single_thread();
-    let mut tracker = Tracker::new(sequence.camera, TrackerConfig::default()).expect("tracker");
-    let mut source = sequence.source();
-    let mut frames = Vec::new();
-    while frames.len() < NUM_FRAMES {
-        let Some(SourceEvent::Frame(frame)) = source.next_event() else {
-            panic!("demo frame {} is missing", frames.len());
-        };
-        let up = sequence.up_in_camera_at(frame.timestamp_s);
-        let tracking = platform_tracking.then(|| {
-            let output = tracker
-                .track(&frame, up.map(|u| u * 9.81))
-                .expect("tracking");
-            PlatformTracking {
-                world_from_camera: output.world_from_camera.map(|m| DMat4::from(m).as_mat4()),
-                feature_points: output
-                    .tracked_points
-                    .iter()
-                    .map(|p| FeaturePoint {
-                        id: p.id,
-                        point_in_world: p.world,
-                    })
-                    .collect(),
-                planes: output
-                    .plane
-                    .map(|p| PlatformPlane {
-                        id: 1,
-                        // As Sylva's tracker's ground: point = normal · offset, in f32.
-                        center_in_world: p.normal.as_vec3() * p.offset as f32,
-                        normal_in_world: p.normal.as_vec3(),
-                        extent_m: [4.0, 4.0],
-                    })
-                    .into_iter()
-                    .collect(),
-                light: None,
-            }
-        });
-        frames.push(PlatformFrame {
-            time_s: frame.timestamp_s - footage.frames[0].time_s,
-            rgba: footage.load_rgba(frame.index).expect("demo image"),
-            intrinsics,
-            tracking,
-            up_in_camera: up,
-        });
-    }
-    (intrinsics, frames)
-}
-
 /// The surface pixel of a camera-image pixel (the image is letterboxed into the surface).
 fn surface_px(app: &ShellApp, surface: &dyn DrawSurface, image_px: Vec2) -> Vec2 {
     let k = app.player().footage.intrinsics;
@@ -119,20 +50,6 @@ fn surface_px(app: &ShellApp, surface: &dyn DrawSurface, image_px: Vec2) -> Vec2
         x + image_px.x / k.width as f32 * w,
         y + image_px.y / k.height as f32 * h,
     )
-}
-
-/// The pixel of the tree's highest point in the shown frame.
-fn top_pixel(app: &ShellApp) -> Option<Vec2> {
-    let player = app.player();
-    let top = player
-        .design
-        .tree
-        .skeleton
-        .internodes
-        .iter()
-        .map(|i| i.end)
-        .max_by(|a, b| a.y.total_cmp(&b.y))?;
-    player.camera_in_tree()?.pixel_from_world(top)
 }
 
 /// The AR view of the shown frame as `sylva replay` renders it (session frame size, no UI).
@@ -170,7 +87,7 @@ struct ShellRun {
 /// stroke up from its top; halfway the app goes to the background, frames arrive and are
 /// dropped, and it comes back rotated to landscape; the tree autosaves all along.
 fn drive_shell(storage: &Path, choice: TrackerChoice) -> ShellRun {
-    let (intrinsics, frames) = demo_frames(choice == TrackerChoice::Platform);
+    let (intrinsics, frames) = demo_frames(choice == TrackerChoice::Platform, NUM_FRAMES);
     let storage = StorageLocation::new(storage);
     let mut app =
         ShellApp::start(&storage, intrinsics, 30.0, choice, "demo camera").expect("starts");
@@ -365,7 +282,7 @@ fn the_own_tracker_path_on_images_only_records_the_frames_the_platform_path_woul
     let recorded = sylva_app::session::Session::load(&own.session)
         .expect("session")
         .frames;
-    let (intrinsics, frames) = demo_frames(true);
+    let (intrinsics, frames) = demo_frames(true, NUM_FRAMES);
     let (mut stream, feed) = sylva_app::platform::PlatformStream::new(
         intrinsics,
         30.0,
@@ -402,7 +319,7 @@ fn the_own_tracker_path_on_images_only_records_the_frames_the_platform_path_woul
 #[test]
 fn a_platform_frame_without_tracking_is_a_clear_error() {
     let dir = tempfile::tempdir().expect("temp dir");
-    let (intrinsics, mut frames) = demo_frames(false);
+    let (intrinsics, mut frames) = demo_frames(false, NUM_FRAMES);
     let mut app = ShellApp::start(
         &StorageLocation::new(dir.path()),
         intrinsics,

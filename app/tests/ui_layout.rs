@@ -1,6 +1,7 @@
 //! The default layout leaves the planted tree in view (issue 20, Done-when 5): at a desktop
 //! window's 1280×800 and at a phone's 1080×2340 pixels held upright (scale factor 3, so
-//! 360×780 points), no panel and no control of the UI covers the tree's projected bounding box.
+//! 360×780 points; the camera image letterboxed, or cropped to fill the screen as the phone shell
+//! shows it), no panel and no control of the UI covers the tree's projected bounding box.
 //! The tree is a 12-year-old maple framed as a user frames it: its crown filling most of the
 //! camera image's height, in the middle.
 
@@ -9,6 +10,7 @@ mod ui_harness;
 use egui_kittest::Harness;
 use egui_kittest::kittest::{NodeT, Queryable, by};
 use glam::Vec3;
+use sylva_app::platform::DisplayTransform;
 use sylva_app::render::{Intrinsics, ViewCamera};
 use sylva_app::state::{DesignState, InputEvent, Parameters};
 use sylva_app::ui::UiState;
@@ -145,6 +147,15 @@ fn no_panel_covers_the_planted_tree_on_a_phone_held_upright() {
         (
             "phone, landscape camera",
             Intrinsics::from_fov(640, 480, 60f32.to_radians()),
+        ),
+        (
+            // As the phone shell shows its camera: cropped to fill the screen (the tree framed
+            // in what is shown).
+            "phone, camera filling the screen",
+            DisplayTransform::phone(0).shown_intrinsics(
+                &Intrinsics::from_fov(640, 480, 60f32.to_radians()),
+                (1080, 2340),
+            ),
         ),
     ] {
         let h = ui_harness::harness_at_scale(app(k), 360.0, 780.0, 3.0);

@@ -4,9 +4,14 @@
 
 use std::time::Instant;
 
+use super::DisplayTransform;
 use crate::player::Player;
 use crate::render::resources::letterbox;
 use crate::render::{FrameView, Gpu, Renderer};
+
+/// What the renderer's camera image and occluder were made for: the footage frame, where the
+/// tree stood, how the image was shown and the target's size.
+type Uploaded = (usize, Option<glam::Affine3A>, DisplayTransform, (u32, u32));
 
 /// The renderer, the UI's context and renderer, and what they hold of the design.
 pub struct ViewDrawer {
@@ -17,8 +22,10 @@ pub struct ViewDrawer {
     meshed_revision: Option<u64>,
     /// The camera of the 3D view outside AR (framed on the tree when the view opens).
     orbit: Option<crate::ui::orbit::OrbitCamera>,
-    /// Footage frame whose image and occluder the renderer holds.
-    uploaded_frame: Option<(usize, Option<glam::Affine3A>)>,
+    /// Footage frame whose image and occluder the renderer holds (and how the image was shown).
+    uploaded_frame: Option<Uploaded>,
+    /// How the camera image is shown (turned upright, filling the view on a phone).
+    display: DisplayTransform,
 }
 
 impl ViewDrawer {
@@ -34,7 +41,19 @@ impl ViewDrawer {
             meshed_revision: None,
             orbit: None,
             uploaded_frame: None,
+            display: DisplayTransform::default(),
         }
+    }
+
+    /// Shows the camera image turned and cropped by `display` (a phone's display transform;
+    /// the default shows it whole, as the desktop window does).
+    pub fn set_display(&mut self, display: DisplayTransform) {
+        self.display = display;
+    }
+
+    /// How the camera image is shown.
+    pub fn display(&self) -> DisplayTransform {
+        self.display
     }
 
     /// The UI's context (for a shell's input translation).
@@ -77,6 +96,8 @@ impl ViewDrawer {
         player.ui.budget.render_ms = render_started.elapsed().as_secs_f32() * 1000.0;
 
         let intrinsics = player.footage.intrinsics;
+        let display = self.display;
+        let shown = display.shown_intrinsics(&intrinsics, size);
         let orbit = &mut self.orbit;
         let output = self.egui_ctx.run_ui(raw, |ui| {
             let mut events = Vec::new();
@@ -88,7 +109,25 @@ impl ViewDrawer {
                         letterbox(size, &intrinsics)[2] / intrinsics.width as f32 * intrinsics.fx;
                     crate::ui::orbit::orbit_view_ui(ui, view, orbit, focal);
                 }
-                None => crate::ui::touch::view_touches_ui(ui, view, size, &intrinsics, &mut events),
+                None => {
+                    // Touches land on the shown image; the design works in the sensor's.
+                    let mut touches = Vec::new();
+                    crate::ui::touch::view_touches_ui(ui, view, size, &shown, &mut touches);
+                    let sensor = (intrinsics.width, intrinsics.height);
+                    events.extend(touches.into_iter().map(|e| match e {
+                        crate::state::InputEvent::Touch { phase, id, x, y } => {
+                            let p =
+                                display.sensor_from_shown_px(glam::Vec2::new(x, y), sensor, size);
+                            crate::state::InputEvent::Touch {
+                                phase,
+                                id,
+                                x: p.x,
+                                y: p.y,
+                            }
+                        }
+                        other => other,
+                    }));
+                }
             }
             for e in events {
                 player.input(e);
@@ -175,6 +214,7 @@ impl ViewDrawer {
             self.renderer
                 .render(gpu, encoder, target, size, &FrameView::tree_only(camera));
         } else if let Some(camera) = player.camera_in_tree() {
+            let camera = self.display.shown_camera(&camera, size);
             // The frame is drawn in tree space (the tree's mesh is), after planting.
             let revision = Some(player.design.revision)
                 .filter(|_| player.ui.ground_found && player.design.is_planted());
@@ -192,11 +232,25 @@ impl ViewDrawer {
                 self.meshed_revision = revision;
             }
             // The footage image and the occluder change with the shown frame, not per redraw.
-            let placed = (player.frame, player.design.world_from_tree);
+            let placed = (
+                player.frame,
+                player.design.world_from_tree,
+                self.display,
+                size,
+            );
             if self.uploaded_frame != Some(placed) {
                 if let Some(image) = &player.image {
-                    self.renderer
-                        .set_camera_image(gpu, image.as_raw(), player.footage.intrinsics);
+                    if self.display.is_identity() {
+                        self.renderer.set_camera_image(
+                            gpu,
+                            image.as_raw(),
+                            player.footage.intrinsics,
+                        );
+                    } else {
+                        let shown = self.display.shown_image(image, size);
+                        self.renderer
+                            .set_camera_image(gpu, shown.as_raw(), camera.intrinsics);
+                    }
                 }
                 if let Some(scene) = player.scene() {
                     let occluder = crate::planting::occluder_in_tree(

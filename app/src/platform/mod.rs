@@ -9,7 +9,8 @@
 //!   [`crate::scene_tracking::SceneFrame`]s (pose, ground, tracked points, depth mesh), so a
 //!   session recorded on a phone replays on desktop like one recorded there.
 //! - **A surface to draw on** ([`DrawSurface`]): a window's swap chain ([`WindowSurface`]) or an
-//!   offscreen texture ([`OffscreenSurface`], host tests).
+//!   offscreen texture ([`OffscreenSurface`], host tests); the camera image is shown through the
+//!   platform's display transform ([`DisplayTransform`]: turned upright, cropped to fill).
 //! - **Touch input** ([`TouchInput`]): fingers in surface pixels, fed to the UI as egui touches.
 //! - **Storage** ([`StorageLocation`]): where sessions, recordings and autosaves go (app storage
 //!   on a phone).
@@ -23,6 +24,7 @@
 //! Sylva's tracker and renderer: shells convert from the platforms' OpenGL-style cameras,
 //! [`camera_from_gl_camera`]).
 
+mod display;
 mod draw;
 mod shell;
 mod storage;
@@ -35,6 +37,7 @@ mod yuv;
 use glam::{DVec3, Mat4, Vec3};
 use image::RgbaImage;
 
+pub use display::DisplayTransform;
 pub use draw::ViewDrawer;
 pub use shell::{ShellApp, TouchInput};
 pub use storage::StorageLocation;
@@ -140,6 +143,13 @@ pub trait FrameProvider {
     fn pause(&mut self) -> anyhow::Result<()>;
     /// The app comes back: restart the camera.
     fn resume(&mut self) -> anyhow::Result<()>;
+    /// Clockwise quarter turns that show the camera image upright on the screen as the phone is
+    /// held now (Android: `(sensor orientation − display rotation) / 90°`, as
+    /// `ArFrame_transformCoordinates2d` applies it; iOS: the rotation of
+    /// `ARFrame.displayTransform(for:viewportSize:)`). 0 for an image that is already upright.
+    fn display_quarter_turns_cw(&self) -> u8 {
+        0
+    }
 }
 
 /// Sylva's camera axes (X right, Y down, looking along +Z) from an OpenGL-style camera's (X

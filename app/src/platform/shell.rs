@@ -7,8 +7,8 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use super::{
-    DrawSurface, PlatformFeed, PlatformFrame, PlatformIntrinsics, PlatformStream, StorageLocation,
-    TrackerChoice, ViewDrawer,
+    DisplayTransform, DrawSurface, PlatformFeed, PlatformFrame, PlatformIntrinsics, PlatformStream,
+    StorageLocation, TrackerChoice, ViewDrawer,
 };
 use crate::autosave::{AUTOSAVE_INTERVAL, Autosaver};
 use crate::player::Player;
@@ -32,6 +32,8 @@ pub struct ShellApp {
     session_dir: PathBuf,
     autosaver: Autosaver,
     drawer: Option<ViewDrawer>,
+    /// How the camera image is shown ([`ShellApp::set_display`]).
+    display: DisplayTransform,
     /// UI input since the last draw.
     events: Vec<egui::Event>,
     /// Fingers down, and the one that moves egui's pointer (buttons, sliders).
@@ -70,6 +72,7 @@ impl ShellApp {
             session_dir,
             autosaver,
             drawer: None,
+            display: DisplayTransform::default(),
             events: Vec::new(),
             touches_down: Vec::new(),
             pointer_touch: None,
@@ -151,6 +154,13 @@ impl ShellApp {
         }
     }
 
+    /// Shows the camera image through `display` from the next draw on: a phone turns it upright
+    /// and crops it to fill the screen ([`DisplayTransform::phone`]); touches on it still reach
+    /// the design in the camera image's pixels. The default shows the image whole.
+    pub fn set_display(&mut self, display: DisplayTransform) {
+        self.display = display;
+    }
+
     /// Draws the shown frame and the UI into `surface` with `gpu` (the shell's, kept across
     /// pauses: only the surface goes with the window), applying the touches since the last
     /// draw; false when the surface could not draw now.
@@ -186,6 +196,7 @@ impl ShellApp {
             .entry(egui::ViewportId::ROOT)
             .or_default()
             .native_pixels_per_point = Some(ppp);
+        drawer.set_display(self.display);
         drawer.draw(gpu, &mut self.player, &target, size, raw);
         surface.end_frame(gpu)?;
         if self.player.ui.export_requested {

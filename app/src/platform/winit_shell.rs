@@ -12,7 +12,10 @@ use winit::event::WindowEvent;
 use winit::event_loop::{ActiveEventLoop, EventLoop};
 use winit::window::{Window, WindowId};
 
-use super::{FrameProvider, ShellApp, StorageLocation, TouchInput, TrackerChoice, WindowSurface};
+use super::{
+    DisplayTransform, FrameProvider, ShellApp, StorageLocation, TouchInput, TrackerChoice,
+    WindowSurface,
+};
 use crate::render::Gpu;
 use crate::state::TouchPhase;
 
@@ -121,6 +124,11 @@ impl PhoneShell {
         if let Err(error) = app.poll_autosave(Instant::now()) {
             eprintln!("warning: {error:#}");
         }
+        // The camera as a phone shows it: upright (the turn follows the phone's rotation),
+        // filling the screen.
+        app.set_display(DisplayTransform::phone(
+            self.provider.display_quarter_turns_cw(),
+        ));
         app.draw(gpu, surface)?;
         Ok(())
     }

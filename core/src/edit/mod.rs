@@ -13,6 +13,7 @@
 pub mod bend;
 mod bend_solver;
 pub mod brush;
+mod diff;
 pub mod history;
 mod horn;
 pub mod lasso;

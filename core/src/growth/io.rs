@@ -16,6 +16,9 @@ use super::Tree;
 /// Version written by this build; files with a larger version are refused.
 pub const TREE_FORMAT_VERSION: u32 = 1;
 const FORMAT_NAME: &str = "sylva-tree";
+/// Largest tree file [`Tree::load`] reads, bytes (a 300 000-internode tree saves to about
+/// 200 MB).
+const MAX_TREE_FILE_BYTES: u64 = 1 << 30;
 
 /// Why a tree file could not be saved or loaded.
 #[derive(Debug, thiserror::Error)]
@@ -303,18 +306,82 @@ impl Tree {
         })
     }
 
-    /// Loads a tree saved by [`Tree::save`] or [`Tree::save_as`] (either format).
+    /// Loads a tree saved by [`Tree::save`] or [`Tree::save_as`] (either format). Only a regular
+    /// file of at most 1 GiB is read (a FIFO would block, `/dev/zero` would fill memory).
     pub fn load(path: impl AsRef<Path>) -> Result<Tree, TreeFileError> {
         let path = path.as_ref();
         let shown = path.display().to_string();
-        let bytes = std::fs::read(path).map_err(|source| TreeFileError::Read {
-            path: shown.clone(),
-            source,
-        })?;
+        let bytes =
+            read_bounded(path, MAX_TREE_FILE_BYTES).map_err(|source| TreeFileError::Read {
+                path: shown.clone(),
+                source,
+            })?;
         if Self::is_compact_file(&bytes) {
             Self::from_compact_bytes_named(&bytes, &shown)
         } else {
             Self::from_json_bytes_named(&bytes, &shown)
         }
+    }
+}
+
+/// The bytes of the regular file at `path`, at most `max_bytes` of them (checked before it is
+/// opened and on the opened handle; a file growing while read stops one byte past the limit).
+fn read_bounded(path: &Path, max_bytes: u64) -> std::io::Result<Vec<u8>> {
+    use std::io::{Error, ErrorKind, Read};
+    let regular = |metadata: &std::fs::Metadata| {
+        if metadata.is_file() {
+            Ok(())
+        } else {
+            Err(Error::new(ErrorKind::InvalidInput, "not a regular file"))
+        }
+    };
+    let too_large = |size: u64| {
+        Error::new(
+            ErrorKind::InvalidData,
+            format!("file is larger than the {max_bytes} bytes allowed (at least {size} bytes)"),
+        )
+    };
+    regular(&std::fs::metadata(path)?)?;
+    let file = std::fs::File::open(path)?;
+    let opened = file.metadata()?;
+    regular(&opened)?;
+    if opened.len() > max_bytes {
+        return Err(too_large(opened.len()));
+    }
+    let mut bytes = Vec::with_capacity(usize::try_from(opened.len()).unwrap_or(0));
+    file.take(max_bytes.saturating_add(1))
+        .read_to_end(&mut bytes)?;
+    if bytes.len() as u64 > max_bytes {
+        return Err(too_large(bytes.len() as u64));
+    }
+    Ok(bytes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn loading_a_device_or_an_oversized_file_as_a_tree_is_a_clear_error_not_a_hang() {
+        #[cfg(unix)]
+        {
+            let e = Tree::load("/dev/zero").expect_err("a device is no tree file");
+            let text = e.to_string();
+            assert!(
+                text.contains("/dev/zero") && text.contains("not a regular file"),
+                "{text}"
+            );
+        }
+        let dir = tempfile::tempdir().expect("tempdir");
+        let huge = dir.path().join("huge.tree.json");
+        // Sparse: no disk is used.
+        std::fs::File::create(&huge)
+            .and_then(|f| f.set_len(MAX_TREE_FILE_BYTES + 1))
+            .expect("sparse file");
+        let text = Tree::load(&huge).expect_err("too large").to_string();
+        assert!(
+            text.contains("huge.tree.json") && text.contains("larger than"),
+            "{text}"
+        );
     }
 }
