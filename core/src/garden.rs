@@ -30,6 +30,7 @@
 mod competition;
 mod index;
 mod io;
+mod members;
 mod planting;
 mod shade;
 mod stats;
@@ -46,6 +47,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::Tree;
+use crate::environment::{Scene, SceneMode};
 use crate::species::Species;
 
 /// The oldest a tree may be planted or a garden grown, years (a damaged file or a typo beyond).
@@ -130,6 +132,13 @@ impl Garden {
     /// Grows every tree `years` more years together (each to its planting age plus the
     /// garden's years, rounded to whole iterations of its species).
     pub fn grow_years(&mut self, years: f32) {
+        self.grow_years_in(years, &[]);
+    }
+
+    /// [`Garden::grow_years`], each tree growing against its scene (`scenes[i]`, in tree i's
+    /// own space, with how it shapes growth; none past the slice's end): a design's trees
+    /// standing in a tracked scene.
+    pub fn grow_years_in(&mut self, years: f32, scenes: &[Option<(&dyn Scene, SceneMode)>]) {
         let years = years.clamp(0.0, MAX_GARDEN_YEARS);
         let steps: Vec<u32> = self
             .trees
@@ -151,16 +160,16 @@ impl Garden {
                     (k + 1) * n / r > k * n / r
                 })
                 .collect();
-            self.grow_round(&due);
+            self.grow_round(&due, scenes);
         }
         self.years += years;
     }
 
     /// One round: the neighbours brought into each tree's environment, then one iteration of
     /// every tree that is `due`, then the shade of what grew and what was shed handed on.
-    fn grow_round(&mut self, due: &[bool]) {
+    fn grow_round(&mut self, due: &[bool], scenes: &[Option<(&dyn Scene, SceneMode)>]) {
         if !self.competition {
-            self.step_due(due);
+            self.step_due(due, scenes);
             return;
         }
         competition::link_neighbours(self);
@@ -172,7 +181,7 @@ impl Garden {
             .zip(due)
             .map(|(t, &d)| d.then(|| competition::node_ends(t)))
             .collect();
-        self.step_due(due);
+        self.step_due(due, scenes);
         let changes: Vec<Option<competition::NodeChanges>> = self
             .trees
             .par_iter()
@@ -184,13 +193,14 @@ impl Garden {
     }
 
     /// One autonomous iteration of every tree that is `due`, in parallel.
-    fn step_due(&mut self, due: &[bool]) {
+    fn step_due(&mut self, due: &[bool], scenes: &[Option<(&dyn Scene, SceneMode)>]) {
         self.trees
             .par_iter_mut()
             .zip(due)
-            .filter(|(_, d)| **d)
-            .for_each(|(t, _)| {
-                t.tree.grow(1, None);
+            .enumerate()
+            .filter(|(_, (_, d))| **d)
+            .for_each(|(i, (t, _))| {
+                t.tree.grow(1, scenes.get(i).copied().flatten());
             });
     }
 
