@@ -14,6 +14,7 @@ pub mod demo_script;
 pub mod desktop;
 pub mod footage;
 pub mod frame_report;
+pub mod garden_view;
 pub mod live;
 #[cfg(not(any(target_os = "android", target_os = "ios")))]
 pub mod live_capture;

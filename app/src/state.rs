@@ -29,7 +29,9 @@ use crate::render::{GroundPlane, ViewCamera};
 use crate::scale::{DesignScale, ScaleTool};
 use crate::scene_tracking::SceneOccupancy;
 
+mod garden;
 mod tools;
+pub use garden::{GardenMember, OtherTree};
 pub use tools::{DEFAULT_BRANCH_DIAMETER_M, LASSO_MAX_ITERATIONS, Tool};
 
 /// Growth and brush parameters the UI exposes.
@@ -244,6 +246,17 @@ pub enum InputEvent {
         tree_file: String,
         world_from_tree: Option<[f32; 12]>,
     },
+    /// "Plant another tree": the next tap on the ground plants a tree of `species` there
+    /// (module `garden`).
+    PlantAnother {
+        species: String,
+    },
+    /// Selects tree `index` of the garden (a tap on a tree selects it too).
+    SelectTree {
+        index: usize,
+    },
+    /// Deletes the selected tree of a garden (undoable).
+    DeleteTree,
 }
 
 /// A brush stroke.
@@ -320,6 +333,8 @@ pub struct DesignState {
     grow_debt: f32,
     /// The editing tool and its gesture in progress.
     tools: tools::ToolState,
+    /// The other trees of a garden, and planting them (module `garden`).
+    pub garden: garden::GardenDesign,
 }
 
 /// Grows `tree` autonomously to iteration `target` (keeping each iteration in `timeline`) against
@@ -415,6 +430,7 @@ impl DesignState {
             revision: 0,
             grow_debt: 0.0,
             tools: Default::default(),
+            garden: Default::default(),
         }
     }
 
@@ -425,7 +441,7 @@ impl DesignState {
 
     /// Number of undo steps available.
     pub fn undo_depth(&self) -> usize {
-        self.history.num_undoable()
+        self.history.num_undoable() + self.garden_undo_depth()
     }
 
     pub(crate) fn changed(&mut self) {
@@ -491,7 +507,7 @@ impl DesignState {
             InputEvent::Touch { phase, id, x, y } => self.touch(*phase, *id, Vec2::new(*x, *y)),
             InputEvent::Parameters { parameters } => self.set_parameters(parameters),
             InputEvent::Undo => {
-                if self.history.undo(&mut self.tree).is_some() {
+                if !self.undo_garden_step_first() && self.history.undo(&mut self.tree).is_some() {
                     self.brush = None;
                     self.bend = None;
                     self.selected = None;
@@ -512,6 +528,9 @@ impl DesignState {
                     self.restore_tree(tree, *world_from_tree);
                 }
             }
+            InputEvent::PlantAnother { species } => self.arm_planting(species),
+            InputEvent::SelectTree { index } => self.select_tree(*index),
+            InputEvent::DeleteTree => self.delete_selected_tree(),
         }
     }
 
@@ -542,6 +561,9 @@ impl DesignState {
     fn set_parameters(&mut self, parameters: &Parameters) {
         // Controls cannot make parameters that fail the check; a damaged session can.
         if *parameters == self.params || parameters.check().is_err() {
+            return;
+        }
+        if self.garden_parameters(parameters) {
             return;
         }
         self.history.record(OperationKind::Parameters, &self.tree);
@@ -652,6 +674,9 @@ impl DesignState {
             self.scale.touch(phase, id, pixel);
             return;
         }
+        if self.planting_touch(phase, id, pixel) {
+            return;
+        }
         if self.tool_touch(phase, id, pixel) {
             return;
         }
@@ -710,7 +735,7 @@ impl DesignState {
                     return;
                 }
                 self.end_stroke(!is_tap);
-                if is_tap {
+                if is_tap && !self.garden_tap(pixel) {
                     self.tap(pixel);
                 }
             }

@@ -10,6 +10,10 @@ use crate::render::pipelines::{DEPTH_FORMAT, Pipelines, SAMPLE_COUNT};
 use crate::render::tree_gpu::{GpuTree, TreePipelines};
 use crate::render::{FrameView, Gpu, GroundStyle};
 
+/// The camera a frame picks each tree's level of detail for, and its focal length in pixels.
+#[derive(Clone, Copy)]
+struct LevelCamera(crate::render::ViewCamera, f32);
+
 /// Side of the square shadow map, texels.
 const SHADOW_MAP_SIZE: u32 = 2048;
 const BRUSH_VERTICES: u32 = 12 * 24 * 6;
@@ -53,6 +57,8 @@ pub struct Renderer {
     scene_group: wgpu::BindGroup,
     shadow_group: wgpu::BindGroup,
     tree: GpuTree,
+    /// The garden's other trees (slots 1..), drawn as the tree is, each at its own level.
+    others: Vec<GpuTree>,
     /// The level of detail the last frame drew.
     drawn_level: usize,
     occluder: Option<GpuMesh>,
@@ -153,6 +159,7 @@ impl Renderer {
             scene_group,
             shadow_group,
             tree,
+            others: Vec::new(),
             drawn_level: 0,
             occluder: None,
             wireframe: None,
@@ -172,6 +179,46 @@ impl Renderer {
         self.tree.set(gpu, &self.pipelines, tree);
     }
 
+    /// Uploads tree `slot` of a garden (0: the tree [`Self::set_tree`] sets; the others, in
+    /// the same space, drawn with it), making the slots up to it.
+    pub fn set_garden_tree(&mut self, gpu: &Gpu, slot: usize, tree: &TreeMesh) {
+        let Some(other) = slot.checked_sub(1) else {
+            return self.set_tree(gpu, tree);
+        };
+        while self.others.len() <= other {
+            self.others.push(GpuTree::new(gpu, &self.pipelines));
+        }
+        self.others[other].set(gpu, &self.pipelines, tree);
+    }
+
+    /// Keeps the first `num_trees` garden slots (at least the tree's), dropping the rest.
+    pub fn keep_garden_trees(&mut self, num_trees: usize) {
+        self.others.truncate(num_trees.saturating_sub(1));
+    }
+
+    /// Bounds of every tree drawn.
+    fn trees_bounds(&self) -> Option<(Vec3, Vec3)> {
+        std::iter::once(&self.tree)
+            .chain(&self.others)
+            .filter_map(GpuTree::bounds)
+            .reduce(|(a0, a1), (b0, b1)| (a0.min(b0), a1.max(b1)))
+    }
+
+    /// Draws every tree with `parts`, each at its level for the frame's camera.
+    fn draw_trees(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        parts: TreePipelines,
+        camera: LevelCamera,
+    ) {
+        pass.set_bind_group(1, self.tree.group(), &[]);
+        self.tree.draw(pass, self.drawn_level, parts);
+        for other in &self.others {
+            pass.set_bind_group(1, other.group(), &[]);
+            other.draw(pass, other.level_for(&camera.0, camera.1), parts);
+        }
+    }
+
     /// The level of detail the last frame drew (0 = finest).
     pub fn drawn_level(&self) -> usize {
         self.drawn_level
@@ -187,6 +234,16 @@ impl Renderer {
             .intrinsics
             .scaled_to(region[2].round() as u32, region[3].round() as u32);
         self.tree.level_for(&view.camera, camera.fy)
+    }
+
+    /// The camera and focal length (pixels of the drawn region) the levels are picked for.
+    fn level_camera(&self, view: &FrameView, size: (u32, u32)) -> LevelCamera {
+        let region = letterbox(size, &view.camera.intrinsics);
+        let camera = view
+            .camera
+            .intrinsics
+            .scaled_to(region[2].round() as u32, region[3].round() as u32);
+        LevelCamera(view.camera, camera.fy)
     }
 
     /// Uploads the scene's depth mesh (occluder and wireframe).
@@ -301,7 +358,8 @@ impl Renderer {
         let globals = self.globals_for(view, region);
         gpu.queue
             .write_buffer(&self.globals, 0, bytemuck::bytes_of(&globals));
-        self.shadow_pass(encoder);
+        let level_camera = self.level_camera(view, size);
+        self.shadow_pass(encoder, level_camera);
         let Some((_, msaa_color, msaa_depth)) = &self.targets else {
             return;
         };
@@ -337,7 +395,7 @@ impl Renderer {
         if view.occlude {
             draw(&mut pass, &p.occluder, self.occluder.as_ref());
         }
-        if view.ground.is_some() && self.tree.bounds().is_some() {
+        if view.ground.is_some() && self.trees_bounds().is_some() {
             pass.set_pipeline(match view.ground_style {
                 GroundStyle::ShadowCatcher => &p.ground_shadow,
                 GroundStyle::Lawn => &p.ground_lawn,
@@ -349,7 +407,7 @@ impl Renderer {
             cards: &p.cards,
             fruit: &p.fruit,
         };
-        self.tree.draw(&mut pass, self.drawn_level, parts);
+        self.draw_trees(&mut pass, parts, level_camera);
         if view.debug.depth_wireframe {
             draw(&mut pass, &p.wire, self.wireframe.as_ref());
         }
@@ -366,7 +424,7 @@ impl Renderer {
         }
     }
 
-    fn shadow_pass(&self, encoder: &mut wgpu::CommandEncoder) {
+    fn shadow_pass(&self, encoder: &mut wgpu::CommandEncoder, level_camera: LevelCamera) {
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("sun shadow map"),
             color_attachments: &[],
@@ -390,7 +448,7 @@ impl Renderer {
             cards: &p.shadow_cards,
             fruit: &p.shadow_branches,
         };
-        self.tree.draw(&mut pass, self.drawn_level, parts);
+        self.draw_trees(&mut pass, parts, level_camera);
     }
 
     fn globals_for(&self, view: &FrameView, region: [f32; 4]) -> Globals {
@@ -403,7 +461,7 @@ impl Renderer {
         };
         let light = &view.lighting;
         let sun = light.sun_direction.try_normalize().unwrap_or(Vec3::Y);
-        let (centre, radius) = match self.tree.bounds() {
+        let (centre, radius) = match self.trees_bounds() {
             Some((lo, hi)) => (0.5 * (lo + hi), (0.5 * (hi - lo)).length().max(0.05)),
             None => (Vec3::ZERO, 1.0),
         };
