@@ -27,6 +27,7 @@
 //! before the round, so the garden is the same whatever the number of threads. A garden of one
 //! tree grows exactly that tree.
 
+mod cache;
 mod competition;
 mod index;
 mod io;
@@ -73,6 +74,9 @@ pub struct GardenTree {
     /// Its nodes by coarse cells of garden space (derived, never saved).
     #[serde(skip)]
     pub(crate) node_index: index::NodeIndex,
+    /// Its version and what edits reuse (derived, never saved; module `cache`).
+    #[serde(skip)]
+    pub(crate) cache: cache::EditCache,
 }
 
 impl GardenTree {
@@ -119,6 +123,7 @@ impl Garden {
                     neighbours: Vec::new(),
                     shade_cover: shade::ShadeCover::default(),
                     node_index: index::NodeIndex::default(),
+                    cache: cache::EditCache::default(),
                 }
             })
             .collect();
@@ -201,6 +206,7 @@ impl Garden {
             .filter(|(_, (_, d))| **d)
             .for_each(|(i, (t, _))| {
                 t.tree.grow(1, scenes.get(i).copied().flatten());
+                t.cache.changed();
             });
     }
 
@@ -219,13 +225,14 @@ impl Garden {
         let mut due = vec![false; self.trees.len()];
         due[index] = true;
         competition::link_neighbours(self);
-        competition::gather_neighbour_nodes(self, &due);
+        competition::give_all_neighbour_nodes(self, index);
         competition::set_neighbour_tropisms(self, &due);
         // The edit may grow anywhere: from now on the tree's grid holds all its linked
         // neighbours' shade (cast once, at its first edit; see module `shade`).
         competition::set_shade_everywhere(self, index);
         let before = competition::node_ends(&self.trees[index]);
         edit(&mut self.trees[index].tree);
+        self.trees[index].cache.changed();
         let mut changes: Vec<Option<competition::NodeChanges>> =
             (0..self.trees.len()).map(|_| None).collect();
         changes[index] = Some(competition::NodeChanges::of(&self.trees[index], &before));

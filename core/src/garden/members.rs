@@ -12,7 +12,7 @@
 
 use super::competition::{self, NodeChanges, node_ends};
 use super::planting::{MAX_GARDEN_TREES, MIN_TREE_SPACING_M, check_point};
-use super::{Garden, GardenError, GardenTree, MAX_GARDEN_YEARS, index, shade};
+use super::{Garden, GardenError, GardenTree, MAX_GARDEN_YEARS, cache, index, shade};
 use crate::Tree;
 
 impl Garden {
@@ -75,6 +75,10 @@ impl Garden {
             neighbours: Vec::new(),
             shade_cover: shade::ShadeCover::default(),
             node_index: index::NodeIndex::default(),
+            cache: cache::EditCache {
+                version: cache::fresh_version(),
+                ..Default::default()
+            },
         });
         Ok(index)
     }
@@ -123,7 +127,7 @@ impl Garden {
         let mut due = vec![false; self.trees.len()];
         due[index] = true;
         competition::link_neighbours(self);
-        competition::gather_neighbour_nodes(self, &due);
+        competition::give_all_neighbour_nodes(self, index);
         competition::set_neighbour_tropisms(self, &due);
         competition::set_shade_everywhere(self, index);
         true
@@ -139,6 +143,7 @@ impl Garden {
         }
         let before = node_ends(&self.trees[index]);
         self.trees[index].tree = tree;
+        self.trees[index].cache.changed();
         if !self.competition {
             return true;
         }
