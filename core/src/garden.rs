@@ -178,6 +178,9 @@ impl Garden {
             return;
         }
         competition::link_neighbours(self);
+        // The neighbours' nodes are found through their indexes (an edited tree's is made
+        // anew here, not at every edit: edits never ask for it).
+        competition::index_nodes(self, &vec![false; self.trees.len()]);
         competition::gather_neighbour_nodes(self, due);
         competition::set_neighbour_tropisms(self, due);
         let before: Vec<Option<Vec<Vec3>>> = self
@@ -236,9 +239,9 @@ impl Garden {
         let mut changes: Vec<Option<competition::NodeChanges>> =
             (0..self.trees.len()).map(|_| None).collect();
         changes[index] = Some(competition::NodeChanges::of(&self.trees[index], &before));
-        let mut edited = vec![false; self.trees.len()];
-        edited[index] = true;
-        competition::index_nodes(self, &edited);
+        // Its grid takes every neighbour's shade already, so handing on asks no index: its
+        // own is made anew at the next round.
+        self.trees[index].node_index = index::NodeIndex::default();
         competition::hand_on_shade(self, &changes);
         true
     }

@@ -79,7 +79,6 @@ pub(super) fn link_neighbours(garden: &mut Garden) {
         .par_iter_mut()
         .filter(|t| !t.shade_cover.is_made())
         .for_each(|t| t.shade_cover = ShadeCover::of(&t.tree));
-    index_nodes(garden, &vec![false; garden.trees.len()]);
     let boxes: Vec<(Vec2, Vec2)> = garden
         .trees
         .par_iter_mut()

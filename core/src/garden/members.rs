@@ -165,9 +165,7 @@ impl Garden {
         t.shade_cover.everywhere = true;
         let mut changes: Vec<Option<NodeChanges>> = (0..self.trees.len()).map(|_| None).collect();
         changes[index] = Some(NodeChanges::of(&self.trees[index], &before));
-        let mut edited = vec![false; self.trees.len()];
-        edited[index] = true;
-        competition::index_nodes(self, &edited);
+        self.trees[index].node_index = index::NodeIndex::default();
         competition::hand_on_shade(self, &changes);
         true
     }
