@@ -172,6 +172,9 @@ impl Autosaver {
             .with_context(|| format!("cannot autosave the tree to {}", self.tree_path.display()))?;
         // The tree file is in tree space; where it stands goes beside it.
         crate::player::write_placement(design, &self.tree_path.with_extension("placement.json"))?;
+        // A garden goes beside it, whole (the tree file is its selected tree).
+        let garden_path = self.session_file.with_extension("garden.json");
+        crate::garden_view::write_garden(design, &garden_path)?;
         if let Some(path) = &self.session_path {
             session.save(path)?;
         }

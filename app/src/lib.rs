@@ -16,6 +16,7 @@ pub mod desktop;
 pub mod footage;
 pub mod frame_report;
 pub mod limits;
+pub mod garden_view;
 pub mod live;
 #[cfg(not(any(target_os = "android", target_os = "ios")))]
 pub mod live_capture;

@@ -40,7 +40,10 @@ pub fn is_replay_output(name: &str) -> bool {
         .and_then(|rest| rest.strip_suffix(".png"))
         .is_some_and(|digits| digits.len() >= 4 && digits.bytes().all(|b| b.is_ascii_digit()));
     frame
-        || matches!(name, "tree.json" | "tree.glb" | "placement.json")
+        || matches!(
+            name,
+            "tree.json" | "tree.glb" | "placement.json" | "garden.json" | "garden.placement.json"
+        )
         || safe_write::is_temp_name(name)
 }
 

@@ -433,5 +433,7 @@ pub fn export_tree(design: &DesignState, dir: &Path) -> anyhow::Result<PathBuf> 
     let meshes = sylva_core::geometry::build_tree_meshes(&design.tree);
     sylva_core::export::write_glb(&meshes, &glb)
         .with_context(|| format!("cannot write {}", glb.display()))?;
+    // A garden: every tree, and where each stands (the selected one is tree.json too).
+    crate::garden_view::write_garden(design, &dir.join("garden.json"))?;
     Ok(glb)
 }

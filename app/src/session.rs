@@ -231,6 +231,19 @@ impl Session {
                 InputEvent::Recreate {
                     action: crate::state::RecreateAction::Overlay { opacity, .. },
                 } if !opacity.is_finite() => Some(format!("an overlay opacity of {opacity}")),
+                InputEvent::PlantAnother { species }
+                    if sylva_core::species::Species::by_name(species).is_err() =>
+                {
+                    Some(format!("plants an unknown species {species:?}"))
+                }
+                InputEvent::SelectTree { index }
+                    if *index >= sylva_core::garden::MAX_GARDEN_TREES =>
+                {
+                    Some(format!(
+                        "selects tree {index} (a garden holds at most {})",
+                        sylva_core::garden::MAX_GARDEN_TREES
+                    ))
+                }
                 _ if !timed.time_s.is_finite() => Some("a non-finite time".into()),
                 _ => None,
             };
@@ -270,6 +283,8 @@ pub struct ReplayReport {
     pub frame_sha256: Vec<String>,
     pub num_frames: usize,
     pub ms_per_frame: f64,
+    /// SHA-256 of the garden's file when the design holds several trees (None for one).
+    pub garden_sha256: Option<String>,
 }
 
 impl ReplayReport {
@@ -320,6 +335,7 @@ pub fn replay(
     // tracker and gives the same frames on every machine.
     let mut mesher = SceneMesher::new(&footage.intrinsics);
     let mut tree_mesher = crate::tree_model::TreeMesher::default();
+    let mut garden_mesher = crate::garden_view::GardenMesher::default();
     let mut state = session.initial_design();
     let mut meshed_revision = None;
     let mut frame_sha256 = Vec::new();
@@ -368,6 +384,7 @@ pub fn replay(
             }
             meshed_revision = Some(state.revision);
         }
+        garden_mesher.upload(gpu, renderer, &state, state.is_planted());
         let rgba = footage.load_rgba(index)?;
         renderer.set_camera_image(gpu, rgba.as_raw(), footage.intrinsics);
         // The frame is drawn in tree space (the tree's mesh is): camera, occluder and ground
@@ -397,6 +414,7 @@ pub fn replay(
         frame_sha256,
         num_frames,
         ms_per_frame,
+        garden_sha256: state.garden_sha256(),
     })
 }
 

@@ -29,8 +29,10 @@ use crate::render::{GroundPlane, ViewCamera};
 use crate::scale::{DesignScale, ScaleTool};
 use crate::scene_tracking::SceneOccupancy;
 
+mod garden;
 mod recreate;
 mod tools;
+pub use garden::{GardenMember, OtherTree};
 pub use recreate::{RecreateAction, RecreateMode, RecreateResult};
 pub use tools::{DEFAULT_BRANCH_DIAMETER_M, LASSO_MAX_ITERATIONS, Tool};
 
@@ -246,6 +248,17 @@ pub enum InputEvent {
     Recreate {
         action: RecreateAction,
     },
+    /// "Plant another tree": the next tap on the ground plants a tree of `species` there
+    /// (module `garden`).
+    PlantAnother {
+        species: String,
+    },
+    /// Selects tree `index` of the garden (a tap on a tree selects it too).
+    SelectTree {
+        index: usize,
+    },
+    /// Deletes the selected tree of a garden (undoable).
+    DeleteTree,
 }
 
 /// A brush stroke.
@@ -324,6 +337,8 @@ pub struct DesignState {
     tools: tools::ToolState,
     /// Recreating a real tree: its marks, what was observed for them, the last result.
     pub recreate: RecreateMode,
+    /// The other trees of a garden, and planting them (module `garden`).
+    pub garden: garden::GardenDesign,
 }
 
 /// Grows `tree` autonomously to iteration `target` (keeping each iteration in `timeline`) against
@@ -421,6 +436,7 @@ impl DesignState {
             grow_debt: 0.0,
             tools: Default::default(),
             recreate: RecreateMode::default(),
+            garden: Default::default(),
         }
     }
 
@@ -431,7 +447,7 @@ impl DesignState {
 
     /// Number of undo steps available.
     pub fn undo_depth(&self) -> usize {
-        self.history.num_undoable()
+        self.history.num_undoable() + self.garden_undo_depth()
     }
 
     pub(crate) fn changed(&mut self) {
@@ -497,7 +513,7 @@ impl DesignState {
             InputEvent::Touch { phase, id, x, y } => self.touch(*phase, *id, Vec2::new(*x, *y)),
             InputEvent::Parameters { parameters } => self.set_parameters(parameters),
             InputEvent::Undo => {
-                if self.history.undo(&mut self.tree).is_some() {
+                if !self.undo_garden_step_first() && self.history.undo(&mut self.tree).is_some() {
                     self.brush = None;
                     self.bend = None;
                     self.selected = None;
@@ -519,6 +535,9 @@ impl DesignState {
                 }
             }
             InputEvent::Recreate { action } => self.recreate_action(action),
+            InputEvent::PlantAnother { species } => self.arm_planting(species),
+            InputEvent::SelectTree { index } => self.select_tree(*index),
+            InputEvent::DeleteTree => self.delete_selected_tree(),
         }
     }
 
@@ -549,6 +568,9 @@ impl DesignState {
     fn set_parameters(&mut self, parameters: &Parameters) {
         // Controls cannot make parameters that fail the check; a damaged session can.
         if *parameters == self.params || parameters.check().is_err() {
+            return;
+        }
+        if self.garden_parameters(parameters) {
             return;
         }
         self.history.record(OperationKind::Parameters, &self.tree);
@@ -662,6 +684,9 @@ impl DesignState {
         if self.recreate_touch(phase, id, pixel) {
             return;
         }
+        if self.planting_touch(phase, id, pixel) {
+            return;
+        }
         if self.tool_touch(phase, id, pixel) {
             return;
         }
@@ -720,7 +745,7 @@ impl DesignState {
                     return;
                 }
                 self.end_stroke(!is_tap);
-                if is_tap {
+                if is_tap && !self.garden_tap(pixel) {
                     self.tap(pixel);
                 }
             }

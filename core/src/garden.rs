@@ -27,9 +27,11 @@
 //! before the round, so the garden is the same whatever the number of threads. A garden of one
 //! tree grows exactly that tree.
 
+mod cache;
 mod competition;
 mod index;
 mod io;
+mod members;
 mod planting;
 mod shade;
 mod stats;
@@ -46,6 +48,7 @@ use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::Tree;
+use crate::environment::{Scene, SceneMode};
 use crate::species::Species;
 
 /// The oldest a tree may be planted or a garden grown, years (a damaged file or a typo beyond).
@@ -71,6 +74,9 @@ pub struct GardenTree {
     /// Its nodes by coarse cells of garden space (derived, never saved).
     #[serde(skip)]
     pub(crate) node_index: index::NodeIndex,
+    /// Its version and what edits reuse (derived, never saved; module `cache`).
+    #[serde(skip)]
+    pub(crate) cache: cache::EditCache,
 }
 
 impl GardenTree {
@@ -117,6 +123,7 @@ impl Garden {
                     neighbours: Vec::new(),
                     shade_cover: shade::ShadeCover::default(),
                     node_index: index::NodeIndex::default(),
+                    cache: cache::EditCache::default(),
                 }
             })
             .collect();
@@ -130,6 +137,13 @@ impl Garden {
     /// Grows every tree `years` more years together (each to its planting age plus the
     /// garden's years, rounded to whole iterations of its species).
     pub fn grow_years(&mut self, years: f32) {
+        self.grow_years_in(years, &[]);
+    }
+
+    /// [`Garden::grow_years`], each tree growing against its scene (`scenes[i]`, in tree i's
+    /// own space, with how it shapes growth; none past the slice's end): a design's trees
+    /// standing in a tracked scene.
+    pub fn grow_years_in(&mut self, years: f32, scenes: &[Option<(&dyn Scene, SceneMode)>]) {
         let years = years.clamp(0.0, MAX_GARDEN_YEARS);
         let steps: Vec<u32> = self
             .trees
@@ -151,19 +165,22 @@ impl Garden {
                     (k + 1) * n / r > k * n / r
                 })
                 .collect();
-            self.grow_round(&due);
+            self.grow_round(&due, scenes);
         }
         self.years += years;
     }
 
     /// One round: the neighbours brought into each tree's environment, then one iteration of
     /// every tree that is `due`, then the shade of what grew and what was shed handed on.
-    fn grow_round(&mut self, due: &[bool]) {
+    fn grow_round(&mut self, due: &[bool], scenes: &[Option<(&dyn Scene, SceneMode)>]) {
         if !self.competition {
-            self.step_due(due);
+            self.step_due(due, scenes);
             return;
         }
         competition::link_neighbours(self);
+        // The neighbours' nodes are found through their indexes (an edited tree's is made
+        // anew here, not at every edit: edits never ask for it).
+        competition::index_nodes(self, &vec![false; self.trees.len()]);
         competition::gather_neighbour_nodes(self, due);
         competition::set_neighbour_tropisms(self, due);
         let before: Vec<Option<Vec<Vec3>>> = self
@@ -172,7 +189,7 @@ impl Garden {
             .zip(due)
             .map(|(t, &d)| d.then(|| competition::node_ends(t)))
             .collect();
-        self.step_due(due);
+        self.step_due(due, scenes);
         let changes: Vec<Option<competition::NodeChanges>> = self
             .trees
             .par_iter()
@@ -184,13 +201,15 @@ impl Garden {
     }
 
     /// One autonomous iteration of every tree that is `due`, in parallel.
-    fn step_due(&mut self, due: &[bool]) {
+    fn step_due(&mut self, due: &[bool], scenes: &[Option<(&dyn Scene, SceneMode)>]) {
         self.trees
             .par_iter_mut()
             .zip(due)
-            .filter(|(_, d)| **d)
-            .for_each(|(t, _)| {
-                t.tree.grow(1, None);
+            .enumerate()
+            .filter(|(_, (_, d))| **d)
+            .for_each(|(i, (t, _))| {
+                t.tree.grow(1, scenes.get(i).copied().flatten());
+                t.cache.changed();
             });
     }
 
@@ -209,19 +228,20 @@ impl Garden {
         let mut due = vec![false; self.trees.len()];
         due[index] = true;
         competition::link_neighbours(self);
-        competition::gather_neighbour_nodes(self, &due);
+        competition::give_all_neighbour_nodes(self, index);
         competition::set_neighbour_tropisms(self, &due);
         // The edit may grow anywhere: from now on the tree's grid holds all its linked
         // neighbours' shade (cast once, at its first edit; see module `shade`).
         competition::set_shade_everywhere(self, index);
         let before = competition::node_ends(&self.trees[index]);
         edit(&mut self.trees[index].tree);
+        self.trees[index].cache.changed();
         let mut changes: Vec<Option<competition::NodeChanges>> =
             (0..self.trees.len()).map(|_| None).collect();
         changes[index] = Some(competition::NodeChanges::of(&self.trees[index], &before));
-        let mut edited = vec![false; self.trees.len()];
-        edited[index] = true;
-        competition::index_nodes(self, &edited);
+        // Its grid takes every neighbour's shade already, so handing on asks no index: its
+        // own is made anew at the next round.
+        self.trees[index].node_index = index::NodeIndex::default();
         competition::hand_on_shade(self, &changes);
         true
     }

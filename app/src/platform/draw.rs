@@ -19,6 +19,8 @@ pub struct ViewDrawer {
     egui_ctx: egui::Context,
     egui_renderer: egui_wgpu::Renderer,
     tree_mesher: crate::tree_model::TreeMesher,
+    /// The garden's other trees (drawn with the selected one).
+    garden_mesher: crate::garden_view::GardenMesher,
     meshed_revision: Option<u64>,
     /// The camera of the 3D view outside AR (framed on the tree when the view opens).
     orbit: Option<crate::ui::orbit::OrbitCamera>,
@@ -38,6 +40,7 @@ impl ViewDrawer {
             egui_ctx: egui::Context::default(),
             egui_renderer: egui_wgpu::Renderer::new(&gpu.device, format, Default::default()),
             tree_mesher: Default::default(),
+            garden_mesher: Default::default(),
             meshed_revision: None,
             orbit: None,
             uploaded_frame: None,
@@ -203,6 +206,8 @@ impl ViewDrawer {
                 player.ui.budget.meshing_ms = t.elapsed().as_secs_f32() * 1000.0;
                 self.meshed_revision = Some(player.design.revision);
             }
+            self.garden_mesher
+                .upload(gpu, &mut self.renderer, &player.design, true);
             let drawn = self.tree_mesher.current();
             let orbit = *self.orbit.get_or_insert_with(|| {
                 let (min, max) = drawn
@@ -231,6 +236,8 @@ impl ViewDrawer {
                 player.ui.budget.meshing_ms = t.elapsed().as_secs_f32() * 1000.0;
                 self.meshed_revision = revision;
             }
+            self.garden_mesher
+                .upload(gpu, &mut self.renderer, &player.design, revision.is_some());
             // The footage image and the occluder change with the shown frame, not per redraw.
             let placed = (
                 player.frame,

@@ -11,6 +11,10 @@ use crate::render::shadow::{GroundPatch, shadow_footprint, sun_clip_from_world};
 use crate::render::tree_gpu::{GpuTree, TreePipelines};
 use crate::render::{FrameView, Gpu, GroundStyle};
 
+/// The camera a frame picks each tree's level of detail for, and its focal length in pixels.
+#[derive(Clone, Copy)]
+struct LevelCamera(crate::render::ViewCamera, f32);
+
 /// Side of the square shadow map, texels.
 const SHADOW_MAP_SIZE: u32 = 2048;
 const BRUSH_VERTICES: u32 = 12 * 24 * 6;
@@ -43,10 +47,12 @@ struct Globals {
 /// What the shadow map was drawn for: it is drawn again only when one of these changes (the
 /// tree is uploaded anew, the sun moves, or the drawn level of detail changes), not per camera
 /// frame.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug, PartialEq)]
 struct ShadowKey {
+    /// Counts uploads of any tree of the garden.
     tree_generation: u64,
-    level: usize,
+    /// The level each tree is drawn at (the tree's first, then the garden's others).
+    levels: Vec<usize>,
     light_clip_from_world: Mat4,
 }
 
@@ -74,6 +80,8 @@ pub struct Renderer {
     shadow_drawn: Option<ShadowKey>,
     /// Whether the last frame drew the shadow map (rather than reusing it).
     shadow_redrawn: bool,
+    /// The garden's other trees (slots 1..), drawn as the tree is, each at its own level.
+    others: Vec<GpuTree>,
     /// The level of detail the last frame drew.
     drawn_level: usize,
     occluder: Option<GpuMesh>,
@@ -197,6 +205,7 @@ impl Renderer {
             tree_generation: 0,
             shadow_drawn: None,
             shadow_redrawn: false,
+            others: Vec::new(),
             drawn_level: 0,
             occluder: None,
             wireframe: None,
@@ -228,6 +237,58 @@ impl Renderer {
         self.tree_generation += 1;
     }
 
+    /// Uploads tree `slot` of a garden (0: the tree [`Self::set_tree`] sets; the others, in
+    /// the same space, drawn with it), making the slots up to it.
+    pub fn set_garden_tree(&mut self, gpu: &Gpu, slot: usize, tree: &TreeMesh) {
+        let Some(other) = slot.checked_sub(1) else {
+            return self.set_tree(gpu, tree);
+        };
+        while self.others.len() <= other {
+            self.others.push(GpuTree::new(gpu, &self.pipelines));
+        }
+        self.others[other].set(gpu, &self.pipelines, tree);
+        self.tree_generation += 1;
+    }
+
+    /// Keeps the first `num_trees` garden slots (at least the tree's), dropping the rest.
+    pub fn keep_garden_trees(&mut self, num_trees: usize) {
+        let kept = num_trees.saturating_sub(1);
+        if kept < self.others.len() {
+            self.others.truncate(kept);
+            self.tree_generation += 1;
+        }
+    }
+
+    /// The level each tree is drawn at for `camera` (the tree's first, then the others').
+    fn drawn_levels(&self, camera: LevelCamera) -> Vec<usize> {
+        std::iter::once(self.drawn_level)
+            .chain(self.others.iter().map(|o| o.level_for(&camera.0, camera.1)))
+            .collect()
+    }
+
+    /// Bounds of every tree drawn.
+    fn trees_bounds(&self) -> Option<(Vec3, Vec3)> {
+        std::iter::once(&self.tree)
+            .chain(&self.others)
+            .filter_map(GpuTree::bounds)
+            .reduce(|(a0, a1), (b0, b1)| (a0.min(b0), a1.max(b1)))
+    }
+
+    /// Draws every tree with `parts`, each at its level for the frame's camera.
+    fn draw_trees(
+        &self,
+        pass: &mut wgpu::RenderPass<'_>,
+        parts: TreePipelines,
+        camera: LevelCamera,
+    ) {
+        pass.set_bind_group(1, self.tree.group(), &[]);
+        self.tree.draw(pass, self.drawn_level, parts);
+        for other in &self.others {
+            pass.set_bind_group(1, other.group(), &[]);
+            other.draw(pass, other.level_for(&camera.0, camera.1), parts);
+        }
+    }
+
     /// The level of detail the last frame drew (0 = finest).
     pub fn drawn_level(&self) -> usize {
         self.drawn_level
@@ -243,6 +304,16 @@ impl Renderer {
             .intrinsics
             .scaled_to(region[2].round() as u32, region[3].round() as u32);
         self.tree.level_for(&view.camera, camera.fy)
+    }
+
+    /// The camera and focal length (pixels of the drawn region) the levels are picked for.
+    fn level_camera(&self, view: &FrameView, size: (u32, u32)) -> LevelCamera {
+        let region = letterbox(size, &view.camera.intrinsics);
+        let camera = view
+            .camera
+            .intrinsics
+            .scaled_to(region[2].round() as u32, region[3].round() as u32);
+        LevelCamera(view.camera, camera.fy)
     }
 
     /// Uploads the scene's depth mesh (occluder and wireframe).
@@ -355,14 +426,15 @@ impl Renderer {
         let globals = self.globals_for(view, region, light_clip_from_world);
         gpu.queue
             .write_buffer(&self.globals, 0, bytemuck::bytes_of(&globals));
+        let level_camera = self.level_camera(view, size);
         let shadow = ShadowKey {
             tree_generation: self.tree_generation,
-            level: self.drawn_level,
+            levels: self.drawn_levels(level_camera),
             light_clip_from_world,
         };
-        self.shadow_redrawn = self.shadow_drawn != Some(shadow);
+        self.shadow_redrawn = self.shadow_drawn.as_ref() != Some(&shadow);
         if self.shadow_redrawn {
-            self.shadow_pass(encoder);
+            self.shadow_pass(encoder, level_camera);
             self.shadow_drawn = Some(shadow);
         }
         let Some(targets) = &self.targets else {
@@ -405,7 +477,7 @@ impl Renderer {
         if view.occlude {
             draw(&mut pass, &p.occluder, self.occluder.as_ref());
         }
-        if view.ground.is_some() && self.tree.bounds().is_some() {
+        if view.ground.is_some() && self.trees_bounds().is_some() {
             pass.set_pipeline(match view.ground_style {
                 GroundStyle::ShadowCatcher => &p.ground_shadow,
                 GroundStyle::Lawn => &p.ground_lawn,
@@ -417,7 +489,7 @@ impl Renderer {
             cards: &p.cards,
             fruit: &p.fruit,
         };
-        self.tree.draw(&mut pass, self.drawn_level, parts);
+        self.draw_trees(&mut pass, parts, level_camera);
         if view.debug.depth_wireframe {
             draw(&mut pass, &p.wire, self.wireframe.as_ref());
         }
@@ -434,7 +506,7 @@ impl Renderer {
         }
     }
 
-    fn shadow_pass(&self, encoder: &mut wgpu::CommandEncoder) {
+    fn shadow_pass(&self, encoder: &mut wgpu::CommandEncoder, level_camera: LevelCamera) {
         let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
             label: Some("sun shadow map"),
             color_attachments: &[],
@@ -458,7 +530,7 @@ impl Renderer {
             cards: &p.shadow_cards,
             fruit: &p.shadow_branches,
         };
-        self.tree.draw(&mut pass, self.drawn_level, parts);
+        self.draw_trees(&mut pass, parts, level_camera);
     }
 
     /// The sun's view of the tree's bounding sphere (the shadow map's projection).
@@ -472,10 +544,10 @@ impl Renderer {
         sun_clip_from_world(sun, centre, radius)
     }
 
-    /// Centre and radius of the tree's bounding sphere (a unit sphere at the origin without a
-    /// tree).
+    /// Centre and radius of the bounding sphere of every tree drawn (a unit sphere at the origin
+    /// without a tree).
     fn tree_sphere(&self) -> (Vec3, f32) {
-        match self.tree.bounds() {
+        match self.trees_bounds() {
             Some((lo, hi)) => (0.5 * (lo + hi), (0.5 * (hi - lo)).length().max(0.05)),
             None => (Vec3::ZERO, 1.0),
         }

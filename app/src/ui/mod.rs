@@ -9,6 +9,7 @@
 //! UI functions never change the design directly: they emit [`InputEvent`]s, which the caller
 //! applies and records, so sessions capture every edit.
 
+pub mod garden_ui;
 pub mod orbit;
 pub mod plain;
 pub mod recreate_ui;
@@ -31,6 +32,8 @@ pub enum Tab {
     Advanced,
     /// The metric scale: camera height, known length and the measure tool ([`scale_ui::scale_ui`]).
     Scale,
+    /// Several trees: plant another, pick the one edited, delete ([`garden_ui::garden_ui`]).
+    Garden,
     Export,
     /// Recreating a real tree: marks, "Grow to fit", the measures ([`recreate_ui::recreate_ui`]).
     Recreate,
@@ -74,6 +77,8 @@ pub struct UiState {
     pub seek_progress: Option<(usize, usize)>,
     /// A phone's bottom bar shows the brush sliders and playback (folded away by default).
     pub more_controls: bool,
+    /// The species "Plant another tree" plants.
+    pub garden_species: String,
 }
 
 impl Default for UiState {
@@ -96,6 +101,7 @@ impl Default for UiState {
             panel_rects: Vec::new(),
             more_controls: false,
             seek_progress: None,
+            garden_species: crate::state::DEFAULT_SPECIES.to_owned(),
         }
     }
 }
@@ -117,6 +123,7 @@ pub fn sylva_ui(
                 (Tab::Tree, "Tree"),
                 (Tab::Advanced, "Advanced"),
                 (Tab::Scale, "Scale"),
+                (Tab::Garden, "Garden"),
                 (Tab::Export, "Export"),
                 (Tab::Recreate, "Recreate a tree"),
             ] {
@@ -138,6 +145,13 @@ pub fn sylva_ui(
             Tab::Advanced => plain::advanced_ui(ui, &mut params),
             Tab::Scale => scale_ui::scale_ui(ui, &mut state.known_length_m, design, events),
             Tab::Recreate => recreate_ui::recreate_ui(ui, design, &state.species_names, events),
+            Tab::Garden => garden_ui::garden_ui(
+                ui,
+                &mut state.garden_species,
+                &state.species_names,
+                design,
+                events,
+            ),
             Tab::Export => {
                 if ui.button("Export tree (.glb, .json)").clicked() {
                     state.export_requested = true;
@@ -186,6 +200,7 @@ pub fn sylva_ui(
     }
     let view = ui.available_rect_before_wrap();
     tools_ui::tool_overlays_ui(ui, design, view);
+    garden_ui::garden_overlay_ui(ui, design, view);
     overlays_ui(ui, state, view);
     scale_ui::overlay_ui(ui, design, view);
     scale_ui::status_line_ui(ui, design, view);

@@ -11,6 +11,9 @@ struct Expected {
     tree_sha256: String,
     frames: usize,
     frame_sha256: Vec<String>,
+    /// The garden's file, for a session that plants several trees.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    garden_sha256: Option<String>,
 }
 
 /// Asserts that `report` has the tree and frames of `expected_path` (after writing them there
@@ -20,6 +23,7 @@ pub fn assert_replay_matches(report: &ReplayReport, expected_path: &Path, bless:
         tree_sha256: report.tree_sha256.clone(),
         frames: report.num_frames,
         frame_sha256: report.frame_sha256.clone(),
+        garden_sha256: report.garden_sha256.clone(),
     };
     if bless {
         std::fs::write(
@@ -32,6 +36,10 @@ pub fn assert_replay_matches(report: &ReplayReport, expected_path: &Path, bless:
         serde_json::from_str(&std::fs::read_to_string(expected_path).expect("expected file"))
             .expect("expected json");
     assert_eq!(actual.tree_sha256, expected.tree_sha256, "tree differs");
+    assert_eq!(
+        actual.garden_sha256, expected.garden_sha256,
+        "garden differs"
+    );
     assert_eq!(actual.frames, expected.frames);
     let first_bad = actual
         .frame_sha256

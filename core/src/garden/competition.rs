@@ -79,8 +79,17 @@ pub(super) fn link_neighbours(garden: &mut Garden) {
         .par_iter_mut()
         .filter(|t| !t.shade_cover.is_made())
         .for_each(|t| t.shade_cover = ShadeCover::of(&t.tree));
-    index_nodes(garden, &vec![false; garden.trees.len()]);
-    let boxes: Vec<(Vec2, Vec2)> = garden.trees.par_iter().map(crown_box).collect();
+    let boxes: Vec<(Vec2, Vec2)> = garden
+        .trees
+        .par_iter_mut()
+        .map(|t| {
+            t.cache.kept_crown_box().unwrap_or_else(|| {
+                let b = crown_box(t);
+                t.cache.keep_crown_box(b);
+                b
+            })
+        })
+        .collect();
     let reaches: Vec<f32> = garden.trees.iter().map(reach_m).collect();
     let new_links: Vec<Vec<u32>> = (0..garden.trees.len())
         .into_par_iter()
@@ -208,6 +217,41 @@ pub(super) fn gather_neighbour_nodes(garden: &mut Garden, due: &[bool]) {
     }
 }
 
+/// Gives tree `index` (to be edited) every node of its linked neighbours, in its own space, as
+/// occupied space: a superset of what [`gather_neighbour_nodes`] gives (growth keeps only the
+/// nodes within the occupancy radius of a point, so the extra ones take nothing), kept between
+/// edits while the neighbours stand as they were (module `cache`).
+pub(super) fn give_all_neighbour_nodes(garden: &mut Garden, index: usize) {
+    let t = &garden.trees[index];
+    let versions: Vec<(u32, u64)> = t
+        .neighbours
+        .iter()
+        .map(|&j| (j, garden.trees[j as usize].cache.version))
+        .collect();
+    let fresh = versions.iter().all(|&(_, v)| v != 0)
+        && t.cache
+            .neighbour_nodes
+            .as_ref()
+            .is_some_and(|(kept, _)| *kept == versions);
+    if !fresh {
+        let base = t.base();
+        let nodes: Vec<Vec3> = t
+            .neighbours
+            .iter()
+            .flat_map(|&j| node_ends(&garden.trees[j as usize]))
+            .map(|p| p - base)
+            .collect();
+        garden.trees[index].cache.neighbour_nodes = Some((versions, nodes));
+    }
+    let t = &mut garden.trees[index];
+    let nodes = t.cache.neighbour_nodes.as_ref().map(|(_, n)| n.as_slice());
+    t.tree.environment.neighbour_nodes.clear();
+    t.tree
+        .environment
+        .neighbour_nodes
+        .extend_from_slice(nodes.unwrap_or_default());
+}
+
 /// Indexes anew the nodes of the trees marked `changed` and of any tree without an index.
 pub(super) fn index_nodes(garden: &mut Garden, changed: &[bool]) {
     garden
@@ -252,14 +296,18 @@ pub(super) fn set_neighbour_tropisms(garden: &mut Garden, due: &[bool]) {
         .collect();
     let areas: Vec<f32> = garden
         .trees
-        .par_iter()
+        .par_iter_mut()
         .zip(&needed)
         .map(|(t, &needed)| {
             if !needed {
                 return 0.0;
             }
-            let crown = super::CrownStats::of(t);
-            std::f32::consts::PI * crown.radius_m().max(0.05).powi(2)
+            t.cache.kept_crown_area_m2().unwrap_or_else(|| {
+                let crown = super::CrownStats::of(t);
+                let area = std::f32::consts::PI * crown.radius_m().max(0.05).powi(2);
+                t.cache.keep_crown_area_m2(area);
+                area
+            })
         })
         .collect();
     let tropisms: Vec<Option<glam::Vec3>> = (0..garden.trees.len())
@@ -447,6 +495,7 @@ pub(super) fn rebuild_shade(garden: &mut Garden) {
     let ends: Vec<Vec<Vec3>> = garden.trees.par_iter().map(node_ends).collect();
     let competition = garden.competition;
     garden.trees.par_iter_mut().for_each(|t| {
+        t.cache.changed();
         t.tree.rebuild_shadow();
         t.tree.environment.neighbour_nodes.clear();
         t.shade_cover = ShadeCover::of(&t.tree);
@@ -470,6 +519,66 @@ pub(super) fn rebuild_shade(garden: &mut Garden) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A brush dab beside the crown and a year: an edit that grows both towards persistent
+    /// points and autonomously.
+    fn dab_and_grow(tree: &mut crate::Tree) {
+        let m = tree.metrics();
+        let centre = Vec3::new(0.5 * m.crown_width_m.max(0.5), m.height_m * 0.8, 0.0);
+        let mut rng = crate::Rng::new(5);
+        for _ in 0..200 {
+            tree.environment
+                .attraction
+                .add_persistent(centre + rng.in_unit_ball() * 0.5);
+        }
+        for _ in 0..2 {
+            tree.step(crate::growth::StepOptions {
+                autonomous: false,
+                scene: None,
+            });
+        }
+        tree.grow_years(1.0);
+    }
+
+    #[test]
+    fn an_edit_given_all_the_neighbours_nodes_grows_as_with_only_those_that_can_take_a_point() {
+        let species = |name: &str| crate::species::Species::by_name(name).expect("preset");
+        let planted = vec![
+            crate::garden::PlantedTree::new(species("birch"), 0.0, 0.0, 0.0, 1),
+            crate::garden::PlantedTree::new(species("maple"), 1.6, 0.0, 0.0, 2),
+            crate::garden::PlantedTree::new(species("oak"), -1.4, 0.8, 0.0, 3),
+        ];
+        let mut garden = Garden::plant(planted).expect("plants");
+        garden.grow_years(6.0);
+        for edited in 0..3 {
+            let mut exact = garden.clone();
+            let mut due = vec![false; 3];
+            due[edited] = true;
+            link_neighbours(&mut exact);
+            gather_neighbour_nodes(&mut exact, &due);
+            set_neighbour_tropisms(&mut exact, &due);
+            set_shade_everywhere(&mut exact, edited);
+            assert!(
+                !exact.trees[edited]
+                    .tree
+                    .environment
+                    .neighbour_nodes
+                    .is_empty()
+            );
+            dab_and_grow(&mut exact.trees[edited].tree);
+            let mut all = garden.clone();
+            all.edit_tree(edited, dab_and_grow);
+            assert!(
+                all.trees[edited].tree.environment.neighbour_nodes.len()
+                    >= exact.trees[edited].tree.environment.neighbour_nodes.len()
+            );
+            assert_eq!(
+                exact.trees[edited].tree.to_json_bytes().expect("saves"),
+                all.trees[edited].tree.to_json_bytes().expect("saves"),
+                "tree {edited} grew otherwise"
+            );
+        }
+    }
 
     #[test]
     fn boxes_meet_within_the_margin_only() {

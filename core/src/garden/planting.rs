@@ -291,7 +291,7 @@ impl Planting {
     }
 }
 
-fn check_point(entry: &str, p: Vec2) -> Result<(), GardenError> {
+pub(super) fn check_point(entry: &str, p: Vec2) -> Result<(), GardenError> {
     if p.is_finite() && p.abs().max_element() <= MAX_PLANTING_EXTENT_M {
         Ok(())
     } else {
