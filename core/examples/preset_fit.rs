@@ -5,11 +5,12 @@
 //! `cargo run --release -p sylva-core --example preset_fit -- birch apical_dominance=0.56 ...`
 //! (values as JSON: numbers, `true`, `"spiral"`). `SYLVA_SEEDS=1,2,3` tries other seeds.
 
+#[path = "common/overrides.rs"]
+mod overrides;
 #[path = "common/seeds.rs"]
 mod seeds;
 
 use sylva_core::Tree;
-use sylva_core::species::Species;
 
 /// Seeds tried: the suite's, the README pictures', the benchmark's.
 const SEEDS: [u64; 3] = [2014, 11, 7];
@@ -20,19 +21,7 @@ fn main() {
         eprintln!("usage: preset_fit PRESET [field=json ...]");
         std::process::exit(2);
     };
-    let preset = Species::by_name(name).unwrap_or_else(|e| panic!("{e}"));
-    let mut fields = serde_json::to_value(&preset).expect("a species serializes");
-    for pair in &args[1..] {
-        let (key, value) = pair
-            .split_once('=')
-            .unwrap_or_else(|| panic!("{pair}: expected field=value"));
-        fields[key] = serde_json::from_str(value).unwrap_or_else(|e| panic!("{pair}: {e}"));
-    }
-    let species: Species = serde_json::from_value(fields).unwrap_or_else(|e| panic!("{e}"));
-    if let Err(why) = species.validate() {
-        eprintln!("not a valid species: {why}");
-        std::process::exit(1);
-    }
+    let species = overrides::species_with_overrides(name, &args[1..]);
     let e = species.expected.clone();
     let seeds = seeds::seeds_from_env(&SEEDS);
     let (mut worst, mut worst_lean) = (0.0f32, 0.0f32);

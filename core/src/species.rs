@@ -69,6 +69,23 @@ pub struct ExpectedTrunk {
     pub source: String,
 }
 
+/// Apical control that changes with age: λ moves smoothly (smoothstep) from the species'
+/// `apical_dominance` (young) to `mature_apical_dominance` between the two ages. An oak is
+/// excurrent when young and decurrent when mature: its leader loses dominance and several limbs
+/// co-dominate.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ApicalDominanceWithAge {
+    /// λ from `to_age_years` on.
+    pub mature_apical_dominance: f32,
+    /// Age until which λ keeps its young value, years.
+    pub from_age_years: f32,
+    /// Age from which λ has its mature value, years.
+    pub to_age_years: f32,
+    /// Why these values, with the reference(s) by name.
+    pub notes: String,
+}
+
 impl ExpectedTrunk {
     /// (age in years, [least, most] diameter in metres) of each stated range.
     pub fn ranges(&self) -> [(f32, [f32; 2]); 3] {
@@ -150,6 +167,10 @@ pub struct Species {
     pub shoot_length_halving_age_years: f32,
     /// λ: apical dominance, share of vigor biased to the main axis (0.5 = neutral).
     pub apical_dominance: f32,
+    /// λ changing with age (see [`Species::apical_dominance_at`]); absent keeps
+    /// `apical_dominance` for the tree's whole life.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub apical_dominance_with_age: Option<ApicalDominanceWithAge>,
     /// κ: light sensitivity, Q = b·L^κ (0 = space alone decides).
     pub light_sensitivity: f32,
     /// α: weight of the current heading (straightness).
@@ -476,10 +497,38 @@ impl Species {
         if let Some(trunk) = &self.expected.trunk_diameter {
             trunk.validate()?;
         }
+        if let Some(a) = &self.apical_dominance_with_age {
+            let name = "apical_dominance_with_age";
+            let m = a.mature_apical_dominance;
+            if !(m.is_finite() && (0.0..=1.0).contains(&m)) {
+                return Err(format!(
+                    "{name}.mature_apical_dominance must lie in [0, 1], got {m}"
+                ));
+            }
+            let (from, to) = (a.from_age_years, a.to_age_years);
+            if !(from.is_finite() && to.is_finite() && 0.0 <= from && from < to && to <= 1e4) {
+                return Err(format!(
+                    "{name}: from_age_years and to_age_years must satisfy \
+                     0 <= from_age_years < to_age_years <= 10000, got {from} and {to}"
+                ));
+            }
+        }
         match &self.looks {
             Some(looks) => looks.validate(),
             None => Ok(()),
         }
+    }
+
+    /// λ at `age_years`: `apical_dominance`, or with `apical_dominance_with_age` a smoothstep
+    /// from it to the mature value between the two ages.
+    pub fn apical_dominance_at(&self, age_years: f32) -> f32 {
+        let young = self.apical_dominance;
+        let Some(a) = &self.apical_dominance_with_age else {
+            return young;
+        };
+        let t =
+            ((age_years - a.from_age_years) / (a.to_age_years - a.from_age_years)).clamp(0.0, 1.0);
+        young + (a.mature_apical_dominance - young) * t * t * (3.0 - 2.0 * t)
     }
 
     /// How the species looks: its own `looks`, or for a file without them the look of the
@@ -561,5 +610,73 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.contains("x.json"), "{err}");
+    }
+
+    #[test]
+    fn apical_dominance_moves_smoothly_from_young_to_mature_and_is_constant_without_the_field() {
+        let mut birch = Species::by_name("birch").unwrap();
+        birch.apical_dominance_with_age = None;
+        let young = birch.apical_dominance;
+        for age in [0.0, 10.0, 40.0, 500.0] {
+            assert_eq!(birch.apical_dominance_at(age).to_bits(), young.to_bits());
+        }
+        birch.apical_dominance = 0.6;
+        birch.apical_dominance_with_age = Some(ApicalDominanceWithAge {
+            mature_apical_dominance: 0.4,
+            from_age_years: 10.0,
+            to_age_years: 30.0,
+            notes: String::new(),
+        });
+        assert_eq!(birch.apical_dominance_at(5.0), 0.6);
+        assert_eq!(birch.apical_dominance_at(10.0), 0.6);
+        assert!((birch.apical_dominance_at(20.0) - 0.5).abs() < 1e-6);
+        assert_eq!(birch.apical_dominance_at(30.0), 0.4);
+        assert_eq!(birch.apical_dominance_at(80.0), 0.4);
+        let lambdas: Vec<f32> = (0..=40)
+            .map(|a| birch.apical_dominance_at(a as f32))
+            .collect();
+        assert!(lambdas.windows(2).all(|w| w[1] <= w[0]), "{lambdas:?}");
+        // Smooth: no step larger than the linear ramp's 0.01 a year times smoothstep's 1.5.
+        assert!(
+            lambdas.windows(2).all(|w| w[0] - w[1] <= 0.0151),
+            "{lambdas:?}"
+        );
+    }
+
+    #[test]
+    fn a_bad_apical_dominance_with_age_is_named_in_the_error() {
+        let mut oak = Species::by_name("oak").unwrap();
+        let good = ApicalDominanceWithAge {
+            mature_apical_dominance: 0.5,
+            from_age_years: 20.0,
+            to_age_years: 35.0,
+            notes: String::new(),
+        };
+        let bad = [
+            (1.5, 20.0, 35.0, "mature_apical_dominance"),
+            (0.5, 35.0, 20.0, "to_age_years"),
+            (0.5, -1.0, 20.0, "from_age_years"),
+        ];
+        for (m, from, to, named) in bad {
+            oak.apical_dominance_with_age = Some(ApicalDominanceWithAge {
+                mature_apical_dominance: m,
+                from_age_years: from,
+                to_age_years: to,
+                ..good.clone()
+            });
+            let text = serde_json::to_string(&oak).unwrap();
+            let err = Species::from_json_str(&text, "mine.json")
+                .unwrap_err()
+                .to_string();
+            assert!(
+                err.contains("mine.json")
+                    && err.contains("apical_dominance_with_age")
+                    && err.contains(named),
+                "{err}"
+            );
+        }
+        oak.apical_dominance_with_age = Some(good);
+        let text = serde_json::to_string(&oak).unwrap();
+        assert!(Species::from_json_str(&text, "mine.json").is_ok());
     }
 }

@@ -16,7 +16,7 @@ use crate::tree::NodeId;
 pub(crate) fn distribute(tree: &Tree, scratch: &mut Scratch) -> f32 {
     let nodes = &tree.skeleton.internodes;
     let n = nodes.len();
-    let lambda = tree.species.apical_dominance;
+    let lambda = tree.species.apical_dominance_at(tree.age_years());
     let Scratch {
         buds,
         node_bud_start,
