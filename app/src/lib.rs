@@ -15,8 +15,8 @@ pub mod demo_script;
 pub mod desktop;
 pub mod footage;
 pub mod frame_report;
-pub mod limits;
 pub mod garden_view;
+pub mod limits;
 pub mod live;
 #[cfg(not(any(target_os = "android", target_os = "ios")))]
 pub mod live_capture;

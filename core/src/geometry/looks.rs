@@ -183,7 +183,9 @@ pub struct Looks {
     /// Leaves on branches thinner than this many tip diameters (`tip_diameter_m`).
     pub leafy_diameters: f32,
     /// Angle between a leaf-bearing branch and its leaves' petioles (or a spray card's axis),
-    /// degrees; `None` for the generic 52° (0.9 rad).
+    /// degrees; `None` for the generic 52° (0.9 rad). Left out of saved files when `None`, so
+    /// trees saved before the field keep their bytes (and their hashes).
+    #[serde(skip_serializing_if = "Option::is_none")]
     pub leaf_insertion_deg: Option<f32>,
     /// Leaves drawn on one card (a spray of small leaves, a needle shoot; see
     /// [`super::leaf_card`]).
