@@ -18,7 +18,7 @@ mod io;
 mod light;
 mod parallel;
 mod shoots;
-mod snapshot;
+pub(crate) mod snapshot;
 mod space;
 mod vigor;
 mod widths;

@@ -21,7 +21,7 @@ use glam::Vec3;
 
 use crate::environment::AttractionPoint;
 use crate::growth::Tree;
-use crate::tree::{Bud, Internode, NodeId};
+use crate::tree::{Internode, NodeId};
 
 /// What turns the state after an operation back into the state before it.
 #[derive(Clone, Debug)]
@@ -240,19 +240,7 @@ impl InternodeDiff {
         let spilled: usize = self
             .whole
             .iter()
-            .map(|(_, n)| {
-                let buds = if n.lateral_buds.spilled() {
-                    n.lateral_buds.capacity() * size_of::<Bud>()
-                } else {
-                    0
-                };
-                let children = if n.lateral_children.spilled() {
-                    n.lateral_children.capacity() * size_of::<NodeId>()
-                } else {
-                    0
-                };
-                buds + children
-            })
+            .map(|(_, n)| crate::growth::snapshot::spilled_bytes(n))
             .sum();
         self.runs.capacity() * size_of::<Run>()
             + self.whole.capacity() * size_of::<(NodeId, Internode)>()

@@ -57,28 +57,28 @@ impl Tree {
     /// Heap and inline bytes of the tree's saved state: what a [`Tree::compact_clone`] holds.
     pub fn saved_state_bytes(&self) -> usize {
         let internodes = &self.skeleton.internodes;
-        let spilled: usize = internodes
-            .iter()
-            .map(|n| {
-                let buds = if n.lateral_buds.spilled() {
-                    n.lateral_buds.capacity() * size_of::<Bud>()
-                } else {
-                    0
-                };
-                let children = if n.lateral_children.spilled() {
-                    n.lateral_children.capacity() * size_of::<NodeId>()
-                } else {
-                    0
-                };
-                buds + children
-            })
-            .sum();
+        let spilled: usize = internodes.iter().map(spilled_bytes).sum();
         size_of::<Tree>()
             + internodes.capacity() * size_of::<Internode>()
             + spilled
             + self.environment.attraction.points.capacity() * size_of::<AttractionPoint>()
             + self.environment.neighbour_nodes.capacity() * size_of::<glam::Vec3>()
     }
+}
+
+/// Heap bytes an internode's small vectors took once they outgrew their inline room.
+pub(crate) fn spilled_bytes(n: &Internode) -> usize {
+    let buds = if n.lateral_buds.spilled() {
+        n.lateral_buds.capacity() * size_of::<Bud>()
+    } else {
+        0
+    };
+    let children = if n.lateral_children.spilled() {
+        n.lateral_children.capacity() * size_of::<NodeId>()
+    } else {
+        0
+    };
+    buds + children
 }
 
 #[cfg(test)]
