@@ -22,8 +22,7 @@ use sylva_app::render::offscreen::OFFSCREEN_FORMAT;
 use sylva_app::render::{
     FrameView, Gpu, GroundPlane, OccluderMesh, Offscreen, Renderer, ViewCamera,
 };
-use sylva_app::scene_tracking::SceneMesher;
-use sylva_app::session::{Session, frame_camera, replay};
+use sylva_app::session::{Session, frame_occluders, replay};
 use sylva_app::state::species_named;
 use sylva_app::tree_model::TreeMesher;
 use sylva_core::Tree;
@@ -76,21 +75,13 @@ fn main() -> anyhow::Result<()> {
         .context("the demo session plants no tree")?;
     let tree_from_world = world_from_tree.inverse();
 
-    let mut mesher = SceneMesher::new(&footage.intrinsics);
     let mut frames = Vec::new();
-    for (step, record) in session.frames.iter().enumerate() {
-        let Some(camera) = frame_camera(record, &footage) else {
-            continue;
-        };
-        // The occluder grows from every frame's observations, as in the replay.
-        let occluder = mesher.update(
-            &record.observations(),
-            camera.world_from_camera,
-            record.ground_plane(),
-        );
+    // The occluder grows from every frame's observations, as in the replay.
+    for (step, camera, occluder) in frame_occluders(&session, &footage) {
         if step % stride != 0 {
             continue;
         }
+        let record = &session.frames[step];
         frames.push(Frame {
             rgba: footage.load_rgba(record.index)?,
             camera: camera_in_tree(&camera, &tree_from_world),

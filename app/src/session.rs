@@ -309,6 +309,29 @@ pub fn frame_camera(record: &FrameRecord, footage: &Footage) -> Option<ViewCamer
     ))
 }
 
+/// The occluder of every recorded frame that has a camera, as the replay builds it: the depth
+/// mesh of the tracked points fed with every frame's observations in order. Yields the frame's
+/// step, its camera (world) and the occluder (world).
+pub fn frame_occluders<'a>(
+    session: &'a Session,
+    footage: &'a Footage,
+) -> impl Iterator<Item = (usize, ViewCamera, crate::render::OccluderMesh)> + 'a {
+    let mut mesher = SceneMesher::new(&footage.intrinsics);
+    session
+        .frames
+        .iter()
+        .enumerate()
+        .filter_map(move |(step, record)| {
+            let camera = frame_camera(record, footage)?;
+            let occluder = mesher.update(
+                &record.observations(),
+                camera.world_from_camera,
+                record.ground_plane(),
+            );
+            Some((step, camera, occluder))
+        })
+}
+
 /// Replays `session` (located at `session_path`); writes PNG frames and the tree (`tree.json`, `tree.glb`) into `out` when
 /// given, and renders frames when `render` is set.
 pub fn replay(

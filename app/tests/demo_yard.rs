@@ -17,8 +17,7 @@ use sylva_app::footage::Footage;
 use sylva_app::planting::{camera_in_tree, occluder_in_tree};
 use sylva_app::render::offscreen::OFFSCREEN_FORMAT;
 use sylva_app::render::{FrameView, Gpu, Offscreen, Renderer, TreeMesh};
-use sylva_app::scene_tracking::SceneMesher;
-use sylva_app::session::{Session, frame_camera, replay};
+use sylva_app::session::{Session, frame_occluders, replay};
 use sylva_app::tree_model::mesh_of;
 
 /// The frame the README's picture shows, and where the box is in front of the tree's foot.
@@ -79,18 +78,12 @@ fn the_demo_yard_session_plants_a_spruce_behind_the_box_with_its_crown_in_view_a
     let mut renderer = Renderer::new(&gpu, OFFSCREEN_FORMAT);
     let [width, height] = session.frame_size;
     let target = Offscreen::new(&gpu.device, width, height);
-    let mut mesher = SceneMesher::new(&footage.intrinsics);
     let tree_from_world = world_from_tree.inverse();
     let mut images = None;
-    for (step, record) in session.frames.iter().enumerate().take(SHOWN_FRAME + 1) {
-        let Some(camera) = frame_camera(record, &footage) else {
-            continue;
-        };
-        let occluder = mesher.update(
-            &record.observations(),
-            camera.world_from_camera,
-            record.ground_plane(),
-        );
+    for (step, camera, occluder) in frame_occluders(&session, &footage) {
+        if step > SHOWN_FRAME {
+            break;
+        }
         if step != SHOWN_FRAME {
             continue;
         }

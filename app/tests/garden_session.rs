@@ -11,7 +11,7 @@
 //! Run: `XDG_RUNTIME_DIR=/tmp/sylva-xdg WGPU_BACKEND=vulkan cargo test --release -p sylva-app --test garden_session -- --nocapture`
 
 mod expected;
-mod golden_check;
+mod golden_compare;
 
 use std::path::PathBuf;
 
@@ -22,8 +22,7 @@ use sylva_app::garden_view::placed_mesh;
 use sylva_app::planting::{camera_in_tree, occluder_in_tree};
 use sylva_app::render::offscreen::OFFSCREEN_FORMAT;
 use sylva_app::render::{FrameView, Gpu, Offscreen, Renderer, TreeMesh};
-use sylva_app::scene_tracking::SceneMesher;
-use sylva_app::session::{Session, frame_camera, replay};
+use sylva_app::session::{Session, frame_occluders, replay};
 use sylva_app::state::{DesignState, InputEvent, Parameters, TouchPhase};
 use sylva_app::tree_model::mesh_of;
 
@@ -249,18 +248,12 @@ fn three_birches_planted_in_the_yard_grow_as_a_group_the_middle_one_edited_and_t
     let mut renderer = Renderer::new(&gpu, OFFSCREEN_FORMAT);
     let [width, height] = session.frame_size;
     let target = Offscreen::new(&gpu.device, width, height);
-    let mut mesher = SceneMesher::new(&footage.intrinsics);
     let tree_from_world = world_from_tree.inverse();
     let mut images = None;
-    for (step, record) in session.frames.iter().enumerate().take(SHOWN_FRAME + 1) {
-        let Some(camera) = frame_camera(record, &footage) else {
-            continue;
-        };
-        let occluder = mesher.update(
-            &record.observations(),
-            camera.world_from_camera,
-            record.ground_plane(),
-        );
+    for (step, camera, occluder) in frame_occluders(&session, &footage) {
+        if step > SHOWN_FRAME {
+            break;
+        }
         if step != SHOWN_FRAME {
             continue;
         }
@@ -303,8 +296,7 @@ fn three_birches_planted_in_the_yard_grow_as_a_group_the_middle_one_edited_and_t
     let frame = image::open(out.path().join(format!("frame_{SHOWN_FRAME:04}.png")))
         .expect("the replay wrote the shown frame")
         .to_rgba8();
-    let golden = PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/golden");
-    golden_check::assert_matches_golden(&golden, "garden_three", &frame, 12, 0.005);
+    golden_compare::assert_matches_golden("garden_three", &frame);
     assert!(
         out.path().join("garden.json").exists(),
         "the replay saves the garden"

@@ -24,7 +24,7 @@ use sylva_app::planting::{camera_in_tree, occluder_in_tree};
 use sylva_app::render::offscreen::OFFSCREEN_FORMAT;
 use sylva_app::render::{FrameView, Gpu, OccluderMesh, Offscreen, Renderer, TreeMesh, ViewCamera};
 use sylva_app::scene_tracking::SceneMesher;
-use sylva_app::session::{Session, frame_camera, replay};
+use sylva_app::session::{Session, frame_camera, frame_occluders, replay};
 use sylva_app::state::{InputEvent, Parameters};
 use sylva_app::tree_model::mesh_of;
 use sylva_core::species::Species;
@@ -117,19 +117,10 @@ fn the_tracked_occluder_hides_a_tree_planted_behind_the_box_where_the_true_box_d
     let [width, height] = session.frame_size;
     let target = Offscreen::new(&gpu.device, width, height);
     let truth_mesh = true_occluder(tracked_from_truth);
-    let mut mesher = SceneMesher::new(&footage.intrinsics);
     let (mut num_right, mut num_tree, mut num_hidden, mut num_hidden_right) = (0, 0, 0, 0);
     let (mut num_covered, mut num_covered_right) = (0, 0);
-    for (step, record) in session.frames.iter().enumerate() {
-        let Some(camera) = frame_camera(record, &footage) else {
-            continue;
-        };
-        // The occluder as the replay builds it: every frame's observations, in order.
-        let occluder = mesher.update(
-            &record.observations(),
-            camera.world_from_camera,
-            record.ground_plane(),
-        );
+    // The occluder as the replay builds it: every frame's observations, in order.
+    for (step, camera, occluder) in frame_occluders(&session, &footage) {
         let Some((_, tree, world_from_tree)) = shown.iter().find(|s| s.0 == step) else {
             continue;
         };

@@ -1,5 +1,5 @@
 //! The golden-image comparison shared by the tests that render (`golden.rs`,
-//! `phone_screenshots.rs`).
+//! `phone_screenshots.rs`, `garden_session.rs`).
 //!
 //! Tolerance: a pixel differs when any channel differs by more than 12 (of 255); an image matches
 //! when at most 0.5 % of its pixels differ. On a mismatch the test writes `NAME-actual.png` and
