@@ -112,9 +112,10 @@ fn main() {
             peak_ratio = peak_ratio.max(ratio);
             let (undo, timeline) = design.snapshot_bytes();
             println!(
-                "step {:>6}: {:>6} internodes, iteration {:>4}; design holds {:>7.2} MiB (undo {:.2}, timeline {:.2}), {:.2}x the tree's own size",
+                "step {:>6}: {:>6} internodes, {:>6} attraction points, iteration {:>4}; design holds {:>7.2} MiB (undo {:.2}, timeline {:.2}), {:.2}x the tree's own size",
                 step + 1,
                 design.tree.skeleton.len(),
+                design.tree.environment.attraction.points.len(),
                 design.tree.iteration,
                 mib(held),
                 mib(undo),

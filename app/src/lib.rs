@@ -20,6 +20,7 @@ pub mod limits;
 pub mod live;
 #[cfg(not(any(target_os = "android", target_os = "ios")))]
 pub mod live_capture;
+pub mod memory;
 pub mod outputs;
 pub mod planting;
 pub mod platform;

@@ -339,6 +339,8 @@ pub struct DesignState {
     pub recreate: RecreateMode,
     /// The other trees of a garden, and planting them (module `garden`).
     pub garden: garden::GardenDesign,
+    /// When freed working memory was last given back to the system.
+    free_memory: crate::memory::FreeMemory,
 }
 
 /// Grows `tree` autonomously to iteration `target` (keeping each iteration in `timeline`) against
@@ -437,6 +439,7 @@ impl DesignState {
             tools: Default::default(),
             recreate: RecreateMode::default(),
             garden: Default::default(),
+            free_memory: Default::default(),
         }
     }
 
@@ -479,6 +482,7 @@ impl DesignState {
                 self.grow_once();
             }
         }
+        self.free_memory.after_frame(self.revision, time_s);
     }
 
     /// One brush-guided growth iteration towards the persistent points of the stroke.

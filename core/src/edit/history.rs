@@ -1,5 +1,4 @@
-//! Time (Longay 2014 §5.1.2): operation-level undo/redo, and ungrow/regrow to any earlier
-//! iteration.
+//! Operation-level undo and redo (Longay 2014 §5.1.2; ungrow and regrow are [`super::timeline`]).
 //!
 //! Undo keeps, for each operation, the difference back to the state before it
 //! ([`super::diff`]): the internodes, points and state the operation changed, taken between the
@@ -7,20 +6,13 @@
 //! state, iteration; what is derived from them, shadow grid and pipe exponents, is rebuilt on
 //! restore), so an undone tree saves to exactly the bytes it saved to before the operation; a
 //! stroke, a prune, a bend, a width edit or a parameter change are all undone the same way, and
-//! a step costs what it changed, not a tree.
-//! Both the history and the timeline take an optional byte budget, a multiple of the current
-//! tree's saved state, so their memory stays a fixed multiple of the tree's size however long
-//! a session runs.
-//!
-//! The timeline keeps the state after each growth iteration (thinned under a budget). Ungrowing to iteration k restores
-//! that state, which is the tree grown to k from the same seed (if no edit happened since k);
-//! regrowing restores later states until an edit invalidates them. For a continuous slider
-//! while dragging, [`skeleton_at_iteration`] shows the internodes born up to an iteration.
+//! a step costs what it changed, not a tree. The history takes an optional byte budget, a
+//! multiple of the tree's own size, so its memory stays a fixed multiple of the tree's size
+//! however long a session runs.
 
 use super::EditError;
 use super::diff::TreeDiff;
 use crate::growth::Tree;
-use crate::tree::{NodeId, Skeleton};
 
 /// The kind of an undoable operation (for labels in the UI and session logs).
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
@@ -242,188 +234,6 @@ impl History {
     }
 }
 
-/// A growth state kept by the timeline (a compact copy).
-#[derive(Clone, Debug)]
-struct Kept {
-    iteration: u32,
-    tree: Tree,
-    bytes: usize,
-    /// Every iteration since the previous kept state was autonomous growth (so it regrows
-    /// from that state exactly, given the same scene).
-    autonomous: bool,
-}
-
-/// Growth states by iteration, for ungrow/regrow.
-///
-/// Unbounded by default, every iteration is kept. With a budget ([`Timeline::with_budget`])
-/// the states are thinned as the tree grows so that together they hold at most that many times
-/// the latest tree's own size ([`Tree::own_bytes`]): the first and the latest always stay, and older iterations are kept
-/// farther apart than recent ones (gaps grow with age), so a thousand iterations ungrow to
-/// any recent one and to a coarse ladder of older ones.
-#[derive(Clone, Debug, Default)]
-pub struct Timeline {
-    /// Kept states in increasing iteration.
-    states: Vec<Kept>,
-    /// Thinning budget, in multiples of the latest tree's own size (0 = keep every iteration).
-    pub budget_trees: f32,
-    /// [`Tree::own_bytes`] of the latest tree kept.
-    latest_own_bytes: usize,
-}
-
-impl Timeline {
-    /// A timeline whose states hold at most `budget_trees` times the latest tree's own size.
-    pub fn with_budget(budget_trees: f32) -> Timeline {
-        Timeline {
-            budget_trees,
-            ..Timeline::default()
-        }
-    }
-
-    /// Remembers `tree` as the state at its current iteration, dropping any later states
-    /// (they belong to a future that an edit has just replaced).
-    pub fn keep(&mut self, tree: &Tree) {
-        self.keep_step(tree, false);
-    }
-
-    /// [`Timeline::keep`] for a state reached by one autonomous iteration from the previous
-    /// one: a thinned-out iteration between such states regrows exactly
-    /// ([`Timeline::regrows_autonomously`]).
-    pub fn keep_autonomous(&mut self, tree: &Tree) {
-        self.keep_step(tree, true);
-    }
-
-    fn keep_step(&mut self, tree: &Tree, autonomous: bool) {
-        let k = tree.iteration;
-        let contiguous = match (self.states.first(), self.states.last()) {
-            (Some(first), Some(last)) => first.iteration <= k && k <= last.iteration + 1,
-            _ => false,
-        };
-        if !contiguous {
-            self.states.clear();
-        }
-        self.states.retain(|s| s.iteration < k);
-        let compact = tree.compact_clone();
-        self.latest_own_bytes = tree.own_bytes();
-        self.states.push(Kept {
-            iteration: k,
-            bytes: compact.saved_state_bytes(),
-            tree: compact,
-            autonomous,
-        });
-        self.thin();
-    }
-
-    /// Drops interior states while over the budget: each time the one whose removal leaves the
-    /// smallest gap relative to its age.
-    fn thin(&mut self) {
-        let Some(latest) = self.states.last() else {
-            return;
-        };
-        if self.budget_trees <= 0.0 {
-            return;
-        }
-        let budget = (f64::from(self.budget_trees) * self.latest_own_bytes as f64) as usize;
-        let latest_iteration = latest.iteration;
-        let mut total: usize = self.states.iter().map(|s| s.bytes).sum();
-        while total > budget && self.states.len() > 2 {
-            let cost = |i: usize| {
-                let gap = self.states[i + 1].iteration - self.states[i - 1].iteration;
-                let age = latest_iteration - self.states[i].iteration + 1;
-                f64::from(gap) / f64::from(age)
-            };
-            let victim = (1..self.states.len() - 1)
-                .min_by(|&a, &b| cost(a).total_cmp(&cost(b)))
-                .unwrap_or(1);
-            let removed = self.states.remove(victim);
-            self.states[victim].autonomous &= removed.autonomous;
-            total -= removed.bytes;
-        }
-    }
-
-    /// Whether every iteration from the kept `from` up to `to` was autonomous growth, so that
-    /// growing the state at `from` autonomously reaches the state `to` had.
-    pub fn regrows_autonomously(&self, from: u32, to: u32) -> bool {
-        self.is_kept(from)
-            && self
-                .states
-                .iter()
-                .find(|s| s.iteration > from)
-                .is_some_and(|next| next.iteration >= to && next.autonomous)
-    }
-
-    fn find(&self, iteration: u32) -> Option<&Kept> {
-        self.states
-            .binary_search_by_key(&iteration, |s| s.iteration)
-            .ok()
-            .map(|i| &self.states[i])
-    }
-
-    /// The state at `iteration`, if kept.
-    pub fn at(&self, iteration: u32) -> Option<Tree> {
-        let mut tree = self.find(iteration)?.tree.clone();
-        tree.restore_derived();
-        Some(tree)
-    }
-
-    /// Whether the state at `iteration` is kept.
-    pub fn is_kept(&self, iteration: u32) -> bool {
-        self.find(iteration).is_some()
-    }
-
-    /// The latest kept iteration at or before `iteration` (where ungrowing to a thinned-out
-    /// iteration lands).
-    pub fn kept_at_or_before(&self, iteration: u32) -> Option<u32> {
-        self.states
-            .iter()
-            .rev()
-            .map(|s| s.iteration)
-            .find(|&k| k <= iteration)
-    }
-
-    /// Iterations available (first, last); with a budget some between them are thinned out.
-    pub fn range(&self) -> Option<(u32, u32)> {
-        Some((
-            self.states.first()?.iteration,
-            self.states.last()?.iteration,
-        ))
-    }
-
-    /// Number of states kept.
-    pub fn num_kept(&self) -> usize {
-        self.states.len()
-    }
-
-    /// Bytes the kept states hold.
-    pub fn kept_bytes(&self) -> usize {
-        self.states.iter().map(|s| s.bytes).sum()
-    }
-
-    /// Replaces `tree` by its state at `iteration` (ungrow, or regrow up to the latest kept).
-    pub fn go_to(&self, tree: &mut Tree, iteration: u32) -> Result<(), EditError> {
-        *tree = self.at(iteration).ok_or(EditError::IterationNotKept {
-            iteration,
-            range: self.range(),
-        })?;
-        Ok(())
-    }
-}
-
-/// The skeleton as it looked at `iteration` (internodes born later dropped), for scrubbing a
-/// time slider before committing with [`Timeline::go_to`]. Ids are renumbered compactly.
-pub fn skeleton_at_iteration(skeleton: &Skeleton, iteration: u32) -> Skeleton {
-    let roots: Vec<NodeId> = skeleton
-        .internodes
-        .iter()
-        .enumerate()
-        .filter(|(_, n)| n.born_iteration > iteration)
-        .map(|(i, _)| NodeId(i as u32))
-        .collect();
-    let mut view = skeleton.clone();
-    let flags = view.subtree_flags(&roots);
-    view.remove_flagged(&flags);
-    view
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -431,71 +241,6 @@ mod tests {
 
     fn sapling(seed: u64) -> Tree {
         Tree::new(Species::by_name("birch").expect("preset"), seed)
-    }
-
-    #[test]
-    fn a_budgeted_timeline_stays_within_its_multiple_of_the_tree_and_ungrows_exactly() {
-        let mut tree = sapling(3);
-        let mut timeline = Timeline::with_budget(0.5);
-        timeline.keep(&tree);
-        let mut saved = std::collections::BTreeMap::new();
-        for _ in 0..40 {
-            tree.grow(1, None);
-            timeline.keep(&tree);
-            saved.insert(tree.iteration, tree.to_json_bytes().expect("json"));
-            assert!(
-                timeline.kept_bytes() as f64 <= 0.5 * tree.own_bytes() as f64 + 1.0
-                    || timeline.num_kept() <= 2,
-                "{} bytes kept for a {}-byte tree",
-                timeline.kept_bytes(),
-                tree.own_bytes()
-            );
-        }
-        assert_eq!(timeline.range(), Some((0, 40)), "first and latest stay");
-        assert!(
-            timeline.num_kept() < 41,
-            "thinned: {} kept",
-            timeline.num_kept()
-        );
-        let kept: Vec<u32> = (1..=40).filter(|&k| timeline.is_kept(k)).collect();
-        for &k in &kept {
-            let mut back = tree.clone();
-            timeline.go_to(&mut back, k).expect("kept");
-            assert!(
-                back.to_json_bytes().expect("json") == saved[&k],
-                "ungrow to {k}"
-            );
-        }
-        let missing = (1..40)
-            .find(|&k| !timeline.is_kept(k))
-            .expect("one thinned");
-        assert!(timeline.go_to(&mut tree.clone(), missing).is_err());
-        let landed = timeline.kept_at_or_before(missing).expect("an earlier one");
-        assert!(landed < missing && timeline.is_kept(landed));
-        assert!(
-            !timeline.regrows_autonomously(landed, missing),
-            "kept by keep()"
-        );
-    }
-
-    #[test]
-    fn a_thinned_autonomous_iteration_regrows_exactly_from_the_state_before_it() {
-        let mut tree = sapling(5);
-        let mut timeline = Timeline::with_budget(0.5);
-        timeline.keep(&tree);
-        let mut saved = std::collections::BTreeMap::new();
-        for _ in 0..30 {
-            tree.grow(1, None);
-            timeline.keep_autonomous(&tree);
-            saved.insert(tree.iteration, tree.to_json_bytes().expect("json"));
-        }
-        let missing = (1..30).find(|&k| !timeline.is_kept(k)).expect("thinned");
-        let from = timeline.kept_at_or_before(missing).expect("earlier");
-        assert!(timeline.regrows_autonomously(from, missing));
-        let mut back = tree.clone();
-        timeline.go_to(&mut back, from).expect("kept");
-        back.grow(missing - from, None);
-        assert!(back.to_json_bytes().expect("json") == saved[&missing]);
     }
 
     #[test]

@@ -4,7 +4,7 @@
 //! One concept per module: [`brush`] (brushing and sketching on a brush plane that follows the
 //! device, sketch tropism, selective growth), [`lasso`] (silhouette → chordal axis → envelope → attraction points),
 //! [`prune`], [`bend`] (PriMo on skeletons), [`widths`] (width constraints), [`history`]
-//! (operation-level undo/redo and ungrow/regrow). The depth constraint is one slab kept by the
+//! (operation-level undo/redo), [`timeline`] (ungrow/regrow). The depth constraint is one slab kept by the
 //! tree's environment ([`crate::environment::DepthConstraint`]); brush and lasso add no point
 //! outside it.
 //!
@@ -18,6 +18,7 @@ pub mod history;
 mod horn;
 pub mod lasso;
 pub mod prune;
+pub mod timeline;
 pub mod widths;
 
 pub use bend::{Bend, BendPose, BendSettings, PositionalConstraint};
@@ -25,9 +26,10 @@ pub use brush::{
     BrushPlane, BrushSettings, BrushStroke, StrokeCamera, StrokePoint, begin_selective_growth,
     end_selective_growth,
 };
-pub use history::{History, OperationKind, Timeline, skeleton_at_iteration};
+pub use history::{History, OperationKind};
 pub use lasso::{Lasso, LassoEnvelope};
 pub use prune::{Pruned, branch_to_prune, nearest_internode, prune_at};
+pub use timeline::{Timeline, skeleton_at_iteration};
 pub use widths::set_width_constraint;
 
 /// What an edit refused to do, and why.
