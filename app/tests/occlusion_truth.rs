@@ -37,15 +37,17 @@ const EVAL_FRAMES: std::ops::RangeInclusive<usize> = 120..=235;
 /// What holds with the solids on the ground (measured 2026-12-01: 93.8% of 245 465 tree pixels
 /// right, 93.8% where the true solids cover, 99.4% of the 25 802 behind them hidden; 92.9%,
 /// 92.9% and 99.1% on 2026-12-02 with the species' leaf cards drawn, a fuller crown; 93.4%,
-/// 93.4% and 98.3% once the solids are carved by the free rays of the tracked points). Issue
-/// 20 asks 95% right, not met: the box's right half has no tracked point (its points are on its
-/// left face and top edge), so its solid reaches there through tracks triangulated off its
-/// silhouette, which no free ray crosses; and the wall's solid starts about 15 cm in front of
-/// the true wall. The errors are in the solids, not the frame's depth mesh: drawn with the
-/// solids alone, 93.9% right and 97.7% hidden (`SYLVA_OCCLUSION_DIR` draws the wrong pixels).
-const MIN_RIGHT: f64 = 0.93;
-const MIN_COVERED_RIGHT: f64 = 0.93;
-const MIN_HIDDEN_RIGHT: f64 = 0.98;
+/// 93.4% and 98.3% once the solids are carved by the free rays of the tracked points; 93.7%,
+/// 93.7% and 98.2% of 215 825 tree pixels after merging). Since the solids are shaped by the
+/// usable points only (tracks whose positions spread, sliding along a silhouette, still link a
+/// group but no longer stretch the wall's solid up to 60 cm in front of it): 96.0%, 96.0% and
+/// 95.8% of the 27 084 behind the true box or wall hidden. Issue 20 asks 95% right: met. What
+/// is left: the box's right half has no tracked point, so its solid reaches there through a
+/// track triangulated off its silhouette (15 cm out), and the tracked wall stands about 10 cm
+/// in front of the true wall (its points do).
+const MIN_RIGHT: f64 = 0.955;
+const MIN_COVERED_RIGHT: f64 = 0.955;
+const MIN_HIDDEN_RIGHT: f64 = 0.95;
 
 /// The generator's solids as closed triangle meshes, in the tracked world.
 fn true_occluder(tracked_from_truth: impl Fn(Vec3) -> Vec3) -> OccluderMesh {
@@ -215,8 +217,8 @@ fn the_tracked_occluder_hides_a_tree_planted_behind_the_box_where_the_true_box_d
         100.0 * covered_right
     );
     assert!(num_hidden > 0, "the tree must stand partly behind the box");
-    // Issue 20 asks 95% where the occluder covers; what the tracked points give today is
-    // asserted (see the report above and the README's occlusion paragraph).
+    // Issue 20 asks 95% where the occluder covers; what the tracked points give is asserted
+    // (see the report above and the README's occlusion paragraph).
     assert!(
         right >= MIN_RIGHT
             && covered_right >= MIN_COVERED_RIGHT

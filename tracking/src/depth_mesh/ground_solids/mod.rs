@@ -13,7 +13,9 @@
 //! the frames that saw it, with their spread (Welford) and a few of the camera centres it was
 //! seen from; a frame updates only the points it observes. A point whose positions spread more
 //! than [`GroundSolidsConfig::max_relative_spread`] of its distance (a track that slides along a
-//! silhouette, a mismatch) takes no part.
+//! silhouette, a mismatch) does not shape a solid nor carve one; it still links the points it
+//! lies between into one group (it is on the object's silhouette, just not where its mean is).
+//! On `demo_garden` such tracks stretched the wall's solid up to 60 cm in front of the wall.
 //!
 //! **Solids.** Points higher than [`GroundSolidsConfig::min_height_m`] above the ground are
 //! grouped: two are linked when their footprints on the ground lie within
@@ -281,20 +283,36 @@ impl GroundSolids {
             Vec2::new(offset.dot(u_axis), offset.dot(v_axis))
         };
         let height_of = |p: Vec3| (p - ground_point).dot(up);
-        // Object points: id, footprint (plan coordinates), height, noise of the mean.
-        let mut objects: Vec<(u64, Vec2, f32, f32)> = self
+        // Object points: id, footprint (plan coordinates), height, noise of the mean, usable.
+        let mut objects: Vec<(u64, Vec2, f32, f32, bool)> = self
             .points
             .iter()
             .filter(|(_, p)| p.elevated && p.count >= self.config.min_observations)
             .map(|(&id, p)| {
                 let noise = p.spread_m() / (p.count as f32).sqrt();
-                (id, plan_of(p.position()), height_of(p.position()), noise)
+                let position = p.position();
+                (
+                    id,
+                    plan_of(position),
+                    height_of(position),
+                    noise,
+                    self.usable(p),
+                )
             })
             .collect();
         objects.sort_by(|a, b| a.1.x.total_cmp(&b.1.x));
         let plan: Vec<Vec2> = objects.iter().map(|o| o.1).collect();
+        // Every object point links (a track sliding along a silhouette still lies between
+        // the object's points), only the usable ones shape the solid: a sliding track's mean
+        // stands anywhere between the silhouette and the surface behind it.
         let groups: Vec<Vec<usize>> = link_groups(&plan, self.config.link_distance_m)
             .into_iter()
+            .map(|group| {
+                group
+                    .into_iter()
+                    .filter(|&i| objects[i].4)
+                    .collect::<Vec<_>>()
+            })
             .filter(|group| group.len() >= self.config.min_points)
             .collect();
         if groups.is_empty() {
