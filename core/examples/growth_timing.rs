@@ -5,12 +5,19 @@
 //!
 //! `cargo run --release -p sylva-core --example growth_timing [max_internodes]`
 //!
+//! After each size it prints the time of each step of the iterations
+//! (`sylva_core::growth::timing`: buds, points, space, input, vigor, shoots, shed, finish,
+//! widths), summed over the iterations: process CPU time (all threads), or wall-clock time with
+//! `SYLVA_PHASE_CLOCK=wall`.
+//!
 //! `SYLVA_VERBOSE=1` prints every iteration; `SYLVA_DIGEST=1` prints an FNV-1a digest of each
 //! saved tree (and of the brushed tree), so two builds can be checked to grow the same trees.
 //! `SYLVA_BENCH_SPECIES=FILE` writes the benchmark's species there, for `sylva grow --species
 //! FILE --years 25 --seed 7` (the 100k tree; 9 and 45 years for 10k and 300k).
 
 use std::time::Instant;
+
+use sylva_core::growth::timing;
 
 #[path = "../benches/common/growth_trees.rs"]
 mod growth_trees;
@@ -38,7 +45,31 @@ fn digest(tree: &sylva_core::Tree) -> String {
     digest::fnv1a_hex(&tree.to_json_bytes().expect("tree serializes"))
 }
 
+/// The phase totals since the last reset, as one line.
+fn phase_line(clock_name: &str) -> String {
+    let times = timing::phase_times();
+    let parts: Vec<String> = times
+        .iter()
+        .map(|(phase, t)| format!("{} {:.1}", phase.name(), t.as_secs_f64() * 1e3))
+        .collect();
+    format!("  phases (ms {clock_name}): {}", parts.join(", "))
+}
+
 fn main() {
+    // The phases by the process's CPU time (all threads) unless SYLVA_PHASE_CLOCK=wall: on a
+    // loaded machine wall time mostly measures waiting for a core.
+    let wall_phases = std::env::var("SYLVA_PHASE_CLOCK").is_ok_and(|v| v == "wall");
+    let clock: fn() -> u64 = if wall_phases {
+        timing::wall_clock_ns
+    } else {
+        || process_cpu_ns().unwrap_or(0)
+    };
+    timing::enable_phase_times(Some(clock));
+    let clock_name = if wall_phases {
+        "wall"
+    } else {
+        "cpu, all threads"
+    };
     let max: usize = std::env::args()
         .nth(1)
         .and_then(|a| a.parse().ok())
@@ -54,6 +85,7 @@ fn main() {
         if target > max {
             break;
         }
+        timing::reset_phase_times();
         let (wall, cpu, all_cpu) = (Instant::now(), thread_cpu_ns(), process_cpu_ns());
         let (mut w, mut c) = (Instant::now(), thread_cpu_ns());
         let tree = grow_to_with(target, |tree, stats| {
@@ -83,6 +115,7 @@ fn main() {
             elapsed_ms(all_cpu, process_cpu_ns()),
             rayon::current_num_threads()
         );
+        println!("{}", phase_line(clock_name));
         if digests {
             println!("  digest {}", digest(&tree));
         }
@@ -97,6 +130,7 @@ fn main() {
         .unwrap_or(20);
     // As in the criterion bench: warm working memory, the 20k tree restored now and then.
     let mut t = tree.clone();
+    timing::reset_phase_times();
     for i in 0..repeats {
         next_brush_tree(i, &mut t, &tree, &points);
         let (w, c) = (Instant::now(), thread_cpu_ns());
@@ -110,6 +144,10 @@ fn main() {
         "brush iteration on {} internodes: best {best_wall:.2} ms wall, {best_cpu:.2} ms cpu, mean {:.2} ms wall",
         tree.skeleton.len(),
         total_wall / repeats.max(1) as f64
+    );
+    println!(
+        "{} (all {repeats} steps and the restores' steps)",
+        phase_line(clock_name)
     );
     if digests {
         println!("  digest after {repeats} brush steps {}", digest(&t));

@@ -20,6 +20,7 @@ mod parallel;
 mod shoots;
 pub(crate) mod snapshot;
 mod space;
+pub mod timing;
 mod vigor;
 mod widths;
 
@@ -133,8 +134,8 @@ pub(crate) struct Scratch {
     pub in_mask: Vec<bool>,
     pub acc: Vec<f64>,
     pub subtree_root: Vec<u32>,
-    /// The arena's links as the basipetal vigor pass reads them, compact for the passes that
-    /// follow before the arena changes (acropetal vigor, shedding): main child of node i
+    /// The arena's links as bud collection reads them, compact for the passes that follow
+    /// before the arena changes (both vigor passes, shedding): main child of node i
     /// ([`NO_NODE`] for none) and its lateral children
     /// `lateral[lateral_range[i].0..lateral_range[i].1]` in order.
     pub main_child: Vec<u32>,
@@ -144,6 +145,12 @@ pub(crate) struct Scratch {
     /// iteration `expired_at` ([`buds::collect`] kills them once they outlive the bud lifetime).
     pub expired_below: u32,
     pub expired_at: Option<u32>,
+    /// The autonomous points of each block of buds, and the generator's draws before each
+    /// block (the parallel point generation, [`space`]).
+    pub point_blocks: Vec<Vec<crate::environment::AttractionPoint>>,
+    pub point_block_draws: Vec<u64>,
+    /// Living buds and lateral children of each block of nodes ([`buds::collect`]).
+    pub block_counts: Vec<(u32, u32)>,
 }
 
 /// No part of a tree lies further than this from its base (metres): beyond any real tree, a
@@ -288,9 +295,13 @@ impl Tree {
         self.iteration += 1;
         let mut stats = IterationStats::default();
         let mut scratch = std::mem::take(&mut self.scratch);
+        let mut clock = timing::PhaseClock::start();
         buds::collect(self, &mut scratch);
-        stats.num_points = space::colonize(self, &mut scratch, options);
+        clock.lap(timing::Phase::Collect);
+        stats.num_points = space::colonize(self, &mut scratch, options, &mut clock);
+        clock.lap(timing::Phase::Space);
         stats.num_enabled_buds = light::bud_input(self, &mut scratch);
+        clock.lap(timing::Phase::BudInput);
         let v_max = vigor::distribute(self, &mut scratch);
         stats.num_buds = scratch.buds.len();
         let shed = if options.autonomous && v_max > 0.0 {
@@ -299,9 +310,11 @@ impl Tree {
             Vec::new()
         };
         let removed = subtree_flags(&scratch, &shed);
+        clock.lap(timing::Phase::Vigor);
         let grown = shoots::grow_all(self, &mut scratch, v_max, &removed, options.scene);
         stats.num_shoots = grown.0;
         stats.num_new_internodes = grown.1;
+        clock.lap(timing::Phase::Shoots);
         if !shed.is_empty() {
             // The shoots grew only from kept nodes: the new ones stay.
             let mut removed = removed;
@@ -311,9 +324,12 @@ impl Tree {
         if let Some((scene, SceneMode::PruneToScene)) = options.scene {
             stats.num_pruned_internodes = self.prune_to_scene(scene);
         }
+        clock.lap(timing::Phase::Shed);
         space::finish_iteration(self, &scratch);
+        clock.lap(timing::Phase::Finish);
         self.scratch = scratch;
         self.update_widths();
+        clock.lap(timing::Phase::Widths);
         stats
     }
 

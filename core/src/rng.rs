@@ -43,6 +43,25 @@ impl Rng {
         xorshifted.rotate_right(rot)
     }
 
+    /// Skips `delta` outputs: the generator is then where `delta` calls of
+    /// [`Rng::next_u32`] would have left it (O(log delta) steps, PCG's jump-ahead by
+    /// squaring the affine step; Brown 1994). Lets several threads draw consecutive parts of
+    /// one stream, each from where its part starts.
+    pub fn advance(&mut self, mut delta: u64) {
+        let (mut acc_mult, mut acc_plus) = (1u64, 0u64);
+        let (mut cur_mult, mut cur_plus) = (MULTIPLIER, self.increment);
+        while delta > 0 {
+            if delta & 1 == 1 {
+                acc_mult = acc_mult.wrapping_mul(cur_mult);
+                acc_plus = acc_plus.wrapping_mul(cur_mult).wrapping_add(cur_plus);
+            }
+            cur_plus = cur_mult.wrapping_add(1).wrapping_mul(cur_plus);
+            cur_mult = cur_mult.wrapping_mul(cur_mult);
+            delta >>= 1;
+        }
+        self.state = acc_mult.wrapping_mul(self.state).wrapping_add(acc_plus);
+    }
+
     /// Uniform in [0, 1).
     pub fn next_f32(&mut self) -> f32 {
         (self.next_u32() >> 8) as f32 * (1.0 / 16_777_216.0)
@@ -100,6 +119,20 @@ mod tests {
         let sc: Vec<u32> = (0..16).map(|_| c.next_u32()).collect();
         assert_eq!(sa, sb);
         assert_ne!(sa, sc);
+    }
+
+    #[test]
+    fn advancing_skips_exactly_as_many_outputs_as_drawing_them() {
+        for delta in [0u64, 1, 2, 3, 7, 64, 1000, 12_345] {
+            let mut drawn = Rng::new(99);
+            let mut skipped = drawn.clone();
+            for _ in 0..delta {
+                drawn.next_u32();
+            }
+            skipped.advance(delta);
+            assert_eq!(skipped, drawn, "delta {delta}");
+            assert_eq!(skipped.next_u32(), drawn.next_u32());
+        }
     }
 
     #[test]

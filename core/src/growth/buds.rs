@@ -47,10 +47,11 @@ fn bud_cutoff(tree: &Tree) -> Option<u32> {
     tree.iteration.checked_sub(lifetime)
 }
 
-/// Two passes over the tree (the first on all threads): kills lateral buds older than the bud
-/// lifetime, sets the light exposure L of every node that has buds (step 1, [`super::light`]),
-/// then fills `scratch.buds` with every living bud, node by node (terminal first), with the
-/// mask.
+/// Two passes over the tree, both on all threads by blocks of nodes: kills lateral buds older
+/// than the bud lifetime, sets the light exposure L of every node that has buds (step 1,
+/// [`super::light`]) and counts the buds, then fills `scratch.buds` with every living bud, node by node (terminal first), with the
+/// mask, and takes the arena's compact links (`scratch.main_child`, `lateral_range`,
+/// `lateral`).
 pub(crate) fn collect(tree: &mut Tree, scratch: &mut Scratch) {
     let cutoff = bud_cutoff(tree);
     // Nodes born before `expired` had every lateral bud killed by an earlier pass of this tree
@@ -74,6 +75,9 @@ pub(crate) fn collect(tree: &mut Tree, scratch: &mut Scratch) {
     clear_with_room(&mut scratch.node_bud_start, n + 1);
     clear_with_room(&mut scratch.node_end, n);
     clear_with_room(&mut scratch.in_mask, n);
+    clear_with_room(&mut scratch.main_child, n);
+    clear_with_room(&mut scratch.lateral_range, n);
+    clear_with_room(&mut scratch.lateral, n);
     scratch
         .in_mask
         .resize(nodes.len(), tree.growth_mask.is_none());
@@ -89,74 +93,159 @@ pub(crate) fn collect(tree: &mut Tree, scratch: &mut Scratch) {
     }
     let (species, shadow) = (&tree.species, &tree.environment.shadow);
     let light_matters = species.light_sensitivity > 0.0;
-    // On all threads, node by node: the expired lateral buds die, and a node left with a living
-    // bud gets the light exposure of its buds (each node is its own: any thread count gives the
-    // same values).
+    let Scratch {
+        buds,
+        node_bud_start,
+        node_end,
+        in_mask,
+        main_child,
+        lateral_range,
+        lateral,
+        block_counts,
+        ..
+    } = scratch;
+    // On all threads, by blocks of nodes: the expired lateral buds die, a node left with a
+    // living bud gets the light exposure of its buds, and each block counts its living buds and
+    // lateral children (each node is its own: any thread count gives the same values).
     nodes
-        .par_iter_mut()
-        .with_min_len(PARALLEL_NODES)
-        .for_each(|node| {
-            let expired_before = node.born_iteration < expired;
-            if !expired_before
-                && cutoff.is_some_and(|c| node.born_iteration < c)
-                && node.lateral_buds.iter().any(|b| b.alive)
-            {
-                for bud in &mut node.lateral_buds {
-                    bud.alive = false;
+        .par_chunks_mut(PARALLEL_NODES)
+        .map(|block| {
+            let (mut num_buds, mut num_laterals) = (0u32, 0u32);
+            for node in block {
+                let expired_before = node.born_iteration < expired;
+                if !expired_before
+                    && cutoff.is_some_and(|c| node.born_iteration < c)
+                    && node.lateral_buds.iter().any(|b| b.alive)
+                {
+                    for bud in &mut node.lateral_buds {
+                        bud.alive = false;
+                    }
                 }
+                let terminal = node.terminal_bud.as_ref().is_some_and(|b| b.alive);
+                let laterals = if expired_before {
+                    0
+                } else {
+                    node.lateral_buds.iter().filter(|b| b.alive).count() as u32
+                };
+                if terminal || laterals > 0 {
+                    node.light_exposure = super::light::exposure(species, shadow, node.end);
+                }
+                num_buds += u32::from(terminal) + laterals;
+                num_laterals += node.lateral_children.len() as u32;
             }
-            let has_bud = node.terminal_bud.as_ref().is_some_and(|b| b.alive)
-                || (!expired_before && node.lateral_buds.iter().any(|b| b.alive));
-            if has_bud {
-                node.light_exposure = super::light::exposure(species, shadow, node.end);
-            }
+            (num_buds, num_laterals)
+        })
+        .collect_into_vec(block_counts);
+    let nodes = &*nodes;
+    // Then, again by blocks on all threads, each block fills its own part of the bud list
+    // (node by node, terminal first) and of the links, at offsets summed from the counts.
+    let (total_buds, total_laterals) = block_counts
+        .iter()
+        .fold((0usize, 0usize), |(b, l), &(nb, nl)| {
+            (b + nb as usize, l + nl as usize)
         });
-    for (i, node) in nodes.iter().enumerate() {
-        let expired_before = node.born_iteration < expired;
-        let first = scratch.buds.len();
-        scratch.node_bud_start.push(first as u32);
-        scratch.node_end.push(node.end);
-        let may_grow = scratch.in_mask[i];
-        let mut push = |slot: u32, direction: Vec3| {
-            scratch.buds.push(BudState {
-                node: i as u32,
-                slot,
-                direction,
-                light: 0.0,
-                q: 0.0,
-                vigor: 0.0,
-                enabled: false,
-                may_grow,
-                competes: may_grow,
-            });
-        };
-        if let Some(bud) = &node.terminal_bud
-            && bud.alive
-        {
-            push(TERMINAL, bud.direction);
-        }
-        if !expired_before {
-            for (slot, bud) in node.lateral_buds.iter().enumerate() {
-                if bud.alive {
-                    push(slot as u32, bud.direction);
-                }
-            }
-        }
-        if scratch.buds.len() > first {
-            let light = node.light_exposure;
-            // A bud in full shade (L = 0) can never grow when κ > 0 (Q = b·0^κ = 0): it takes
-            // no part in the competition for space ([`super::space`]).
-            let lit = !light_matters || light > 0.0;
-            for bud in &mut scratch.buds[first..] {
-                bud.light = light;
-                bud.competes = bud.may_grow && lit;
-            }
-        }
+    buds.resize(total_buds, BudState::UNSET);
+    node_bud_start.resize(n + 1, 0);
+    node_end.resize(n, Vec3::ZERO);
+    main_child.resize(n, super::NO_NODE);
+    lateral_range.resize(n, (0, 0));
+    lateral.resize(total_laterals, 0);
+    node_bud_start[n] = total_buds as u32;
+    let mut parts = Vec::with_capacity(block_counts.len());
+    let (mut bud_rest, mut lateral_rest) = (&mut buds[..], &mut lateral[..]);
+    let (mut bud_base, mut lateral_base) = (0usize, 0usize);
+    for &(nb, nl) in block_counts.iter() {
+        let (bud_part, bud_tail) = bud_rest.split_at_mut(nb as usize);
+        let (lateral_part, lateral_tail) = lateral_rest.split_at_mut(nl as usize);
+        parts.push((bud_part, bud_base, lateral_part, lateral_base));
+        (bud_rest, lateral_rest) = (bud_tail, lateral_tail);
+        bud_base += nb as usize;
+        lateral_base += nl as usize;
     }
-    scratch.node_bud_start.push(scratch.buds.len() as u32);
+    nodes
+        .par_chunks(PARALLEL_NODES)
+        .zip(node_bud_start[..n].par_chunks_mut(PARALLEL_NODES))
+        .zip(node_end.par_chunks_mut(PARALLEL_NODES))
+        .zip(main_child.par_chunks_mut(PARALLEL_NODES))
+        .zip(lateral_range.par_chunks_mut(PARALLEL_NODES))
+        .zip(in_mask.par_chunks(PARALLEL_NODES))
+        .zip(parts.into_par_iter())
+        .enumerate()
+        .for_each(
+            |(block, ((((((block_nodes, starts), ends), mains), ranges), mask), part))| {
+                let (block_buds, bud_base, block_laterals, lateral_base) = part;
+                let (mut b, mut l) = (0usize, 0usize);
+                for (k, node) in block_nodes.iter().enumerate() {
+                    let i = block * PARALLEL_NODES + k;
+                    let expired_before = node.born_iteration < expired;
+                    let first = b;
+                    starts[k] = (bud_base + first) as u32;
+                    ends[k] = node.end;
+                    mains[k] = node.main_child.map_or(super::NO_NODE, |c| c.0);
+                    let lateral_start = lateral_base + l;
+                    for c in &node.lateral_children {
+                        block_laterals[l] = c.0;
+                        l += 1;
+                    }
+                    ranges[k] = (lateral_start as u32, (lateral_base + l) as u32);
+                    let may_grow = mask[k];
+                    let mut push = |slot: u32, direction: Vec3| {
+                        block_buds[b] = BudState {
+                            node: i as u32,
+                            slot,
+                            direction,
+                            light: 0.0,
+                            q: 0.0,
+                            vigor: 0.0,
+                            enabled: false,
+                            may_grow,
+                            competes: may_grow,
+                        };
+                        b += 1;
+                    };
+                    if let Some(bud) = &node.terminal_bud
+                        && bud.alive
+                    {
+                        push(TERMINAL, bud.direction);
+                    }
+                    if !expired_before {
+                        for (slot, bud) in node.lateral_buds.iter().enumerate() {
+                            if bud.alive {
+                                push(slot as u32, bud.direction);
+                            }
+                        }
+                    }
+                    if b > first {
+                        let light = node.light_exposure;
+                        // A bud in full shade (L = 0) can never grow when κ > 0 (Q = b·0^κ = 0):
+                        // it takes no part in the competition for space ([`super::space`]).
+                        let lit = !light_matters || light > 0.0;
+                        for bud in &mut block_buds[first..b] {
+                            bud.light = light;
+                            bud.competes = bud.may_grow && lit;
+                        }
+                    }
+                }
+            },
+        );
     let num_buds = scratch.buds.len();
     clear_with_room(&mut scratch.won, num_buds);
     scratch.won.resize(num_buds, WonPoints::default());
+}
+
+impl BudState {
+    /// A placeholder, overwritten before it is read.
+    const UNSET: BudState = BudState {
+        node: 0,
+        slot: 0,
+        direction: Vec3::ZERO,
+        light: 0.0,
+        q: 0.0,
+        vigor: 0.0,
+        enabled: false,
+        may_grow: false,
+        competes: false,
+    };
 }
 
 /// What a bud won in the competition for space (step 2), kept apart from [`BudState`] so

@@ -2,6 +2,7 @@
 //! gravimorphism b = cos²τ + d·sin²τ (Longay 2014 eq. 4.2, 4.6).
 
 use glam::Vec3;
+use rayon::prelude::*;
 
 use super::buds::TERMINAL;
 use super::{Scratch, Tree};
@@ -19,27 +20,35 @@ pub(crate) fn exposure(s: &Species, shadow: &ShadowGrid, node_end: Vec3) -> f32 
 pub(crate) fn bud_input(tree: &Tree, scratch: &mut Scratch) -> usize {
     let s = &tree.species;
     let nodes = &tree.skeleton.internodes;
-    let mut enabled = 0;
-    for (bud, won) in scratch.buds.iter_mut().zip(&scratch.won) {
-        bud.enabled = won.count > 0;
-        enabled += usize::from(bud.enabled);
-        if !bud.enabled {
-            bud.q = 0.0;
-            continue;
-        }
-        let b = if bud.slot == TERMINAL {
-            1.0
-        } else {
-            gravimorphism(
-                &s.gravimorphism,
-                nodes[bud.node as usize].heading(),
-                bud.direction,
-            )
-        };
-        bud.q = b * bud.light.powf(s.light_sensitivity);
-    }
-    enabled
+    // On all threads, bud by bud (each bud's Q is its own; the count is an integer sum).
+    scratch
+        .buds
+        .par_iter_mut()
+        .zip(scratch.won.par_iter())
+        .with_min_len(PARALLEL_BUDS)
+        .map(|(bud, won)| {
+            bud.enabled = won.count > 0;
+            if !bud.enabled {
+                bud.q = 0.0;
+                return 0;
+            }
+            let b = if bud.slot == TERMINAL {
+                1.0
+            } else {
+                gravimorphism(
+                    &s.gravimorphism,
+                    nodes[bud.node as usize].heading(),
+                    bud.direction,
+                )
+            };
+            bud.q = b * bud.light.powf(s.light_sensitivity);
+            1
+        })
+        .sum()
 }
+
+/// Buds per block of the parallel bud-input pass.
+const PARALLEL_BUDS: usize = 4096;
 
 /// b = cos²τ + d·sin²τ: τ the angle between the parent axis H and the vertical, d the distance
 /// from the axis to the control ellipse in the bud's polar direction χ (HVP frame).

@@ -12,9 +12,12 @@
 
 use glam::Vec3;
 
+use rayon::prelude::*;
+
+use super::buds::BudState;
+use super::timing::{Phase, PhaseClock};
 use super::{Scratch, StepOptions, Tree, parallel};
-use crate::environment::{AttractionPoints, SceneMode, clear_with_room};
-use crate::rng::Rng;
+use crate::environment::{AttractionPoint, AttractionPoints, SceneMode, clear_with_room};
 
 /// `Scratch::point_winner` of a point that no bud perceives.
 const NO_WINNER: (u32, Vec3) = (u32::MAX, Vec3::ZERO);
@@ -33,13 +36,19 @@ pub(crate) fn radii(tree: &Tree) -> (f32, f32, f32) {
 }
 
 /// Runs step 2; returns the number of attraction points that survived occupancy.
-pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOptions) -> usize {
+pub(crate) fn colonize(
+    tree: &mut Tree,
+    scratch: &mut Scratch,
+    options: StepOptions,
+    clock: &mut PhaseClock,
+) -> usize {
     let (r, perception, cos_half) = radii(tree);
     // Only competing buds ([`super::buds::collect`] leaves out those in full shade when κ > 0,
     // which can never grow) generate and take points.
     if options.autonomous {
         generate_points(tree, scratch, r, perception, cos_half);
     }
+    clock.lap(Phase::Points);
     // The ground: no point below the plane through the base feeds a bud (brushed points there
     // are dropped too; generated ones never enter the set).
     let ground_y = tree.ground_y();
@@ -265,33 +274,94 @@ pub(crate) fn colonize(tree: &mut Tree, scratch: &mut Scratch, options: StepOpti
     alive_count
 }
 
+/// Competing or not, buds per block of the parallel point generation (a block outweighs
+/// handing it to a thread).
+const POINT_BLOCK_BUDS: usize = 2048;
+
+/// Draws of the generator per autonomous point (polar angle, azimuth, radius).
+const DRAWS_PER_POINT: u64 = 3;
+
 /// Autonomous points: each bud adds 1 + round((max − 1)·L/C) points in its perception shell
 /// (those that fall below the ground are drawn, then dropped).
-fn generate_points(tree: &mut Tree, scratch: &Scratch, r: f32, perception: f32, cos_half: f32) {
+///
+/// On all threads, by blocks of buds: every point takes [`DRAWS_PER_POINT`] draws whether it
+/// is kept or not, so the draws of each block start at a count known from the buds before it,
+/// and each block draws from its own copy of the generator advanced there ([`crate::rng::Rng::advance`]).
+/// The blocks' points are then appended in bud order and the generator advanced past all of
+/// them: the same points, in the same order, and the same generator afterwards as drawing them
+/// one by one, on any number of threads.
+fn generate_points(tree: &mut Tree, scratch: &mut Scratch, r: f32, perception: f32, cos_half: f32) {
     let s = &tree.species;
     let extra = (s.max_points_per_bud - 1) as f32;
+    let full_exposure = s.full_exposure;
     let (r3, p3) = (r * r * r, perception * perception * perception);
-    let points: &mut AttractionPoints = &mut tree.environment.attraction;
-    let rng: &mut Rng = &mut tree.rng;
     let ground_y = tree.skeleton.ground_y();
-    points.points.reserve(scratch.buds.len() * 2);
-    for bud in scratch.buds.iter().filter(|b| b.competes) {
-        let position = scratch.node_end[bud.node as usize];
-        let count = 1 + (extra * (bud.light / s.full_exposure).clamp(0.0, 1.0)).round() as u32;
-        let (b1, b2) = bud.direction.any_orthonormal_pair();
-        for _ in 0..count {
-            // Uniform in the cone: cos of the polar angle uniform in [cos(ζ/2), 1]; radius
-            // uniform in the volume of the shell r..r + d.
-            let cos_polar = 1.0 - rng.next_f32() * (1.0 - cos_half);
-            let sin_polar = (1.0 - cos_polar * cos_polar).max(0.0).sqrt();
-            let (sa, ca) = rng.range_f32(0.0, std::f32::consts::TAU).sin_cos();
-            let dir = cos_polar * bud.direction + sin_polar * (ca * b1 + sa * b2);
-            let radius = (r3 + rng.next_f32() * (p3 - r3)).cbrt();
-            let point = position + dir * radius;
-            if point.y >= ground_y {
-                points.add_transient(point);
-            }
+    let count = |bud: &BudState| {
+        if bud.competes {
+            1 + (extra * (bud.light / full_exposure).clamp(0.0, 1.0)).round() as u32
+        } else {
+            0
         }
+    };
+    let Scratch {
+        buds,
+        node_end,
+        point_blocks,
+        point_block_draws,
+        ..
+    } = scratch;
+    point_block_draws.clear();
+    let mut draws = 0u64;
+    for block in buds.chunks(POINT_BLOCK_BUDS) {
+        point_block_draws.push(draws);
+        let points: u64 = block.iter().map(|b| u64::from(count(b))).sum();
+        draws += DRAWS_PER_POINT * points;
+    }
+    let num_blocks = point_block_draws.len();
+    if point_blocks.len() < num_blocks {
+        point_blocks.resize_with(num_blocks, Vec::new);
+    }
+    let start_rng = tree.rng.clone();
+    point_blocks[..num_blocks]
+        .par_iter_mut()
+        .zip(buds.par_chunks(POINT_BLOCK_BUDS))
+        .zip(point_block_draws.par_iter())
+        .for_each(|((out, block), &first_draw)| {
+            out.clear();
+            let mut rng = start_rng.clone();
+            rng.advance(first_draw);
+            for bud in block {
+                let n = count(bud);
+                if n == 0 {
+                    continue;
+                }
+                let position = node_end[bud.node as usize];
+                let (b1, b2) = bud.direction.any_orthonormal_pair();
+                for _ in 0..n {
+                    // Uniform in the cone: cos of the polar angle uniform in [cos(ζ/2), 1];
+                    // radius uniform in the volume of the shell r..r + d.
+                    let cos_polar = 1.0 - rng.next_f32() * (1.0 - cos_half);
+                    let sin_polar = (1.0 - cos_polar * cos_polar).max(0.0).sqrt();
+                    let (sa, ca) = rng.range_f32(0.0, std::f32::consts::TAU).sin_cos();
+                    let dir = cos_polar * bud.direction + sin_polar * (ca * b1 + sa * b2);
+                    let radius = (r3 + rng.next_f32() * (p3 - r3)).cbrt();
+                    let point = position + dir * radius;
+                    if point.y >= ground_y {
+                        out.push(AttractionPoint {
+                            position: point,
+                            persistent: false,
+                            tropism: None,
+                        });
+                    }
+                }
+            }
+        });
+    tree.rng.advance(draws);
+    let points: &mut AttractionPoints = &mut tree.environment.attraction;
+    let added: usize = point_blocks[..num_blocks].iter().map(Vec::len).sum();
+    points.points.reserve(added);
+    for block in &point_blocks[..num_blocks] {
+        points.points.extend_from_slice(block);
     }
 }
 
@@ -404,6 +474,7 @@ pub(crate) fn finish_iteration(tree: &mut Tree, scratch: &Scratch) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::rng::Rng;
 
     #[test]
     fn the_cone_box_holds_every_point_the_cone_test_accepts_and_is_tight() {

@@ -10,12 +10,11 @@ use super::buds::TERMINAL;
 use super::{NO_NODE, Scratch, Tree};
 use crate::tree::NodeId;
 
-/// Runs both passes; returns v_max, the largest vigor of an enabled bud (0 if none). The
-/// basipetal pass also takes the compact copy of the arena's links (see [`Scratch`]) that the
-/// acropetal pass and shedding use.
+/// Runs both passes; returns v_max, the largest vigor of an enabled bud (0 if none). Both read
+/// the compact copy of the arena's links (see [`Scratch`]) that [`super::buds::collect`] took,
+/// which shedding uses too.
 pub(crate) fn distribute(tree: &Tree, scratch: &mut Scratch) -> f32 {
-    let nodes = &tree.skeleton.internodes;
-    let n = nodes.len();
+    let n = tree.skeleton.len();
     let lambda = tree.species.apical_dominance_at(tree.age_years());
     let Scratch {
         buds,
@@ -30,16 +29,16 @@ pub(crate) fn distribute(tree: &Tree, scratch: &mut Scratch) -> f32 {
         ..
     } = scratch;
     // The basipetal pass writes every entry of these before it reads it.
-    main_child.resize(n, NO_NODE);
-    lateral_range.resize(n, (0, 0));
     q_main.resize(n, 0.0);
     q_lateral.resize(n, 0.0);
     size.resize(n, 1);
-    lateral.clear();
     vigor.clear();
     vigor.resize(n, 0.0);
+    // The links come from bud collection's pass (the arena has not changed since): the
+    // reverse pass reads them, not the internodes.
+    debug_assert_eq!(main_child.len(), n);
+    debug_assert_eq!(lateral_range.len(), n);
     for i in (0..n).rev() {
-        let node = &nodes[i];
         let (mut qm, mut ql) = (0.0, 0.0);
         for bud in &buds[node_bud_start[i] as usize..node_bud_start[i + 1] as usize] {
             if bud.slot == TERMINAL {
@@ -49,20 +48,17 @@ pub(crate) fn distribute(tree: &Tree, scratch: &mut Scratch) -> f32 {
             }
         }
         let mut s = 1;
-        main_child[i] = node.main_child.map_or(NO_NODE, |c| c.0);
-        if let Some(c) = node.main_child {
-            let c = c.index();
+        if main_child[i] != NO_NODE {
+            let c = main_child[i] as usize;
             qm += q_main[c] + q_lateral[c];
             s += size[c];
         }
-        let start = lateral.len() as u32;
-        for &c in &node.lateral_children {
-            lateral.push(c.0);
-            let c = c.index();
+        let (start, end) = lateral_range[i];
+        for &c in &lateral[start as usize..end as usize] {
+            let c = c as usize;
             ql += q_main[c] + q_lateral[c];
             s += size[c];
         }
-        lateral_range[i] = (start, lateral.len() as u32);
         q_main[i] = qm;
         q_lateral[i] = ql;
         size[i] = s;
