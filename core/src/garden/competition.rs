@@ -445,33 +445,36 @@ pub(super) fn hand_on_shade(garden: &mut Garden, changes: &[Option<NodeChanges>]
         .for_each(|((t, own), opens)| {
             let base = t.base();
             let (shadow, cover) = (&mut t.tree.environment.shadow, &mut t.shade_cover);
+            // Every neighbour's added nodes in one cast and its shed ones in another (integer
+            // sums: the same grid as neighbour by neighbour, but sorted into brick order
+            // together, so pyramids of different neighbours in the same bricks share them).
+            let (mut cast, mut uncast) = (Vec::new(), Vec::new());
             for &j in &t.neighbours {
                 if let Some(c) = &changes[j as usize] {
                     let near = |p: &Vec3| cover.covers(*p);
-                    shadow.apply_nodes(c.added.iter().map(|&p| p - base).filter(near), 1);
-                    shadow.apply_nodes(c.removed.iter().map(|&p| p - base).filter(near), -1);
+                    cast.extend(c.added.iter().map(|&p| p - base).filter(near));
+                    uncast.extend(c.removed.iter().map(|&p| p - base).filter(near));
                 }
             }
-            let Some(own) = own else { return };
-            let new = cover.extend(own.added_in_tree.iter().copied());
-            if !opens || new.is_empty() {
-                return;
-            }
-            // The neighbours' nodes already standing in the cells just opened.
-            let mut asked = CellSet::default();
-            for c in new.iter() {
-                let (lo, hi) = cover.cell_box(c);
-                asked.add_box(base + lo, base + hi);
-            }
-            let mut cast = Vec::new();
-            for &j in &t.neighbours {
-                let other = bases[j as usize];
-                indexes[j as usize].for_each_in(&asked, |end| {
-                    let p = (other + end) - base;
-                    if cover.in_cells(&new, p) {
-                        cast.push(p);
-                    }
-                });
+            shadow.apply_nodes(uncast, -1);
+            let new = own.map(|own| cover.extend(own.added_in_tree.iter().copied()));
+            if let Some(new) = new.filter(|new| opens && !new.is_empty()) {
+                // The neighbours' nodes already standing in the cells just opened (none of
+                // them is in `cast`, which holds only nodes of cells covered before).
+                let mut asked = CellSet::default();
+                for c in new.iter() {
+                    let (lo, hi) = cover.cell_box(c);
+                    asked.add_box(base + lo, base + hi);
+                }
+                for &j in &t.neighbours {
+                    let other = bases[j as usize];
+                    indexes[j as usize].for_each_in(&asked, |end| {
+                        let p = (other + end) - base;
+                        if cover.in_cells(&new, p) {
+                            cast.push(p);
+                        }
+                    });
+                }
             }
             shadow.apply_nodes(cast, 1);
         });
