@@ -457,7 +457,9 @@ pub(super) fn hand_on_shade(garden: &mut Garden, changes: &[Option<NodeChanges>]
                 }
             }
             shadow.apply_nodes(uncast, -1);
-            let new = own.map(|own| cover.extend(own.added_in_tree.iter().copied()));
+            let new = own
+                .as_ref()
+                .map(|own| cover.extend(own.added_in_tree.iter().copied()));
             if let Some(new) = new.filter(|new| opens && !new.is_empty()) {
                 // The neighbours' nodes already standing in the cells just opened (none of
                 // them is in `cast`, which holds only nodes of cells covered before).
