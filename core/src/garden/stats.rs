@@ -66,7 +66,8 @@ impl CrownStats {
         let (mut lo, mut hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
         for n in nodes.iter().filter(|n| n.order >= 1 || !has_branches) {
             // A length sqrt(d) adds to a positive (or NaN) sum exactly when d is not <= 0.
-            has_length |= !(n.start.distance_squared(n.end) <= 0.0);
+            let d = n.start.distance_squared(n.end);
+            has_length |= d > 0.0 || d.is_nan();
             let e = Vec2::new(n.end.x, n.end.z);
             lo = lo.min(e);
             hi = hi.max(e);
