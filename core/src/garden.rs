@@ -28,6 +28,7 @@
 //! tree grows exactly that tree.
 
 mod cache;
+mod cell_hash;
 mod competition;
 mod index;
 mod io;

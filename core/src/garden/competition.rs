@@ -18,11 +18,10 @@
 //! **Space.** Before each round a tree due to grow gets, as occupied space in its own space, the
 //! nodes of its linked neighbours close enough to take an attraction point from it.
 
-use std::collections::HashSet;
-
 use glam::{IVec3, Vec2, Vec3};
 use rayon::prelude::*;
 
+use super::cell_hash::{self, cell_set_with_capacity};
 use super::index::{CellSet, NodeIndex};
 use super::shade::ShadeCover;
 use super::{Garden, GardenTree};
@@ -140,13 +139,13 @@ pub(super) fn link_neighbours(garden: &mut Garden) {
 /// Cells of `size` metres holding, or next to one holding, a place where tree `t` (its own
 /// space) can take attraction points this iteration: its nodes with a living bud and its
 /// persistent points.
-fn contact_cells(t: &GardenTree, size: f32) -> HashSet<IVec3> {
+fn contact_cells(t: &GardenTree, size: f32) -> cell_hash::CellSet {
     let cell = |p: Vec3| (p / size).floor().as_ivec3();
     let tree = &t.tree;
     let buds = tree.skeleton.internodes.iter().filter(|n| {
         n.terminal_bud.as_ref().is_some_and(|b| b.alive) || n.lateral_buds.iter().any(|b| b.alive)
     });
-    let own: HashSet<IVec3> = buds
+    let own: cell_hash::CellSet = buds
         .map(|n| cell(n.end))
         .chain(
             tree.environment
@@ -157,7 +156,7 @@ fn contact_cells(t: &GardenTree, size: f32) -> HashSet<IVec3> {
         )
         .collect();
     // Each cell with the 26 around it, so that a neighbour's node needs one look-up.
-    let mut cells = HashSet::with_capacity(own.len() * 4);
+    let mut cells = cell_set_with_capacity(own.len() * 4);
     for c in own {
         for dx in -1..=1 {
             for dy in -1..=1 {
@@ -265,6 +264,18 @@ pub(super) fn index_nodes(garden: &mut Garden, changed: &[bool]) {
         });
 }
 
+/// [`crate::Tree::metrics`]'s `height_m`, the same bits, without its other measures: the
+/// highest node end above the first internode's start.
+fn tree_height_m(tree: &crate::Tree) -> f32 {
+    let nodes = &tree.skeleton.internodes;
+    let base_y = nodes.first().map_or(0.0, |n| n.start.y);
+    // As glam's `Vec3::max` takes it (a NaN end replaces the highest so far).
+    nodes
+        .iter()
+        .fold(base_y, |hi, n| if hi > n.end.y { hi } else { n.end.y })
+        - base_y
+}
+
 /// Weights α_a (relative crown area) and α_d (nearness) of a neighbour's pressure (eq. 6.3).
 const PRESSURE_AREA_WEIGHT: f32 = 0.5;
 const PRESSURE_DISTANCE_WEIGHT: f32 = 0.5;
@@ -303,8 +314,8 @@ pub(super) fn set_neighbour_tropisms(garden: &mut Garden, due: &[bool]) {
                 return 0.0;
             }
             t.cache.kept_crown_area_m2().unwrap_or_else(|| {
-                let crown = super::CrownStats::of(t);
-                let area = std::f32::consts::PI * crown.radius_m().max(0.05).powi(2);
+                let radius = super::CrownStats::radius_only_m(t);
+                let area = std::f32::consts::PI * radius.max(0.05).powi(2);
                 t.cache.keep_crown_area_m2(area);
                 area
             })
@@ -331,7 +342,7 @@ pub(super) fn set_neighbour_tropisms(garden: &mut Garden, due: &[bool]) {
                 v += weight * (base - other) / d;
             }
             let v = v.clamp_length_max(1.0);
-            let height = t.tree.metrics().height_m;
+            let height = tree_height_m(&t.tree);
             let alpha = (height / expected.height_30y_m.max(0.5))
                 .clamp(0.0, 1.0)
                 .sqrt();
@@ -434,33 +445,38 @@ pub(super) fn hand_on_shade(garden: &mut Garden, changes: &[Option<NodeChanges>]
         .for_each(|((t, own), opens)| {
             let base = t.base();
             let (shadow, cover) = (&mut t.tree.environment.shadow, &mut t.shade_cover);
+            // Every neighbour's added nodes in one cast and its shed ones in another (integer
+            // sums: the same grid as neighbour by neighbour, but sorted into brick order
+            // together, so pyramids of different neighbours in the same bricks share them).
+            let (mut cast, mut uncast) = (Vec::new(), Vec::new());
             for &j in &t.neighbours {
                 if let Some(c) = &changes[j as usize] {
                     let near = |p: &Vec3| cover.covers(*p);
-                    shadow.apply_nodes(c.added.iter().map(|&p| p - base).filter(near), 1);
-                    shadow.apply_nodes(c.removed.iter().map(|&p| p - base).filter(near), -1);
+                    cast.extend(c.added.iter().map(|&p| p - base).filter(near));
+                    uncast.extend(c.removed.iter().map(|&p| p - base).filter(near));
                 }
             }
-            let Some(own) = own else { return };
-            let new = cover.extend(own.added_in_tree.iter().copied());
-            if !opens || new.is_empty() {
-                return;
-            }
-            // The neighbours' nodes already standing in the cells just opened.
-            let mut asked = CellSet::default();
-            for c in new.iter() {
-                let (lo, hi) = cover.cell_box(c);
-                asked.add_box(base + lo, base + hi);
-            }
-            let mut cast = Vec::new();
-            for &j in &t.neighbours {
-                let other = bases[j as usize];
-                indexes[j as usize].for_each_in(&asked, |end| {
-                    let p = (other + end) - base;
-                    if cover.in_cells(&new, p) {
-                        cast.push(p);
-                    }
-                });
+            shadow.apply_nodes(uncast, -1);
+            let new = own
+                .as_ref()
+                .map(|own| cover.extend(own.added_in_tree.iter().copied()));
+            if let Some(new) = new.filter(|new| opens && !new.is_empty()) {
+                // The neighbours' nodes already standing in the cells just opened (none of
+                // them is in `cast`, which holds only nodes of cells covered before).
+                let mut asked = CellSet::default();
+                for c in new.iter() {
+                    let (lo, hi) = cover.cell_box(c);
+                    asked.add_box(base + lo, base + hi);
+                }
+                for &j in &t.neighbours {
+                    let other = bases[j as usize];
+                    indexes[j as usize].for_each_in(&asked, |end| {
+                        let p = (other + end) - base;
+                        if cover.in_cells(&new, p) {
+                            cast.push(p);
+                        }
+                    });
+                }
             }
             shadow.apply_nodes(cast, 1);
         });
@@ -577,6 +593,27 @@ mod tests {
                 all.trees[edited].tree.to_json_bytes().expect("saves"),
                 "tree {edited} grew otherwise"
             );
+        }
+    }
+
+    #[test]
+    fn the_lean_crown_measures_are_those_of_the_full_ones() {
+        let species = |name: &str| crate::species::Species::by_name(name).expect("preset");
+        let planted = vec![
+            crate::garden::PlantedTree::new(species("birch"), 0.0, 0.0, 0.0, 1),
+            crate::garden::PlantedTree::new(species("norway_spruce"), 1.6, -2.3, 0.0, 2),
+            crate::garden::PlantedTree::new(species("oak"), -1.4, 0.8, 0.0, 3),
+        ];
+        let mut garden = Garden::plant(planted).expect("plants");
+        for years in [0.0, 1.0, 4.0] {
+            garden.grow_years(years);
+            for t in &garden.trees {
+                let full = super::super::CrownStats::of(t).radius_m();
+                let lean = super::super::CrownStats::radius_only_m(t);
+                assert_eq!(full.to_bits(), lean.to_bits());
+                let height = t.tree.metrics().height_m;
+                assert_eq!(height.to_bits(), tree_height_m(&t.tree).to_bits());
+            }
         }
     }
 

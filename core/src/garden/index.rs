@@ -2,9 +2,9 @@
 //! neighbour only for its nodes near a place (the space a bud perceives, the cells its shade
 //! cover has just opened) instead of walking all of them.
 
-use std::collections::HashSet;
-
 use glam::{IVec3, Vec3};
+
+use super::cell_hash;
 
 use crate::environment::floor_to_ivec3;
 
@@ -90,7 +90,7 @@ impl NodeIndex {
 /// Index cells asked for: those touched by a set of boxes (garden space).
 #[derive(Default)]
 pub(super) struct CellSet {
-    seen: HashSet<IVec3>,
+    seen: cell_hash::CellSet,
     cells: Vec<IVec3>,
 }
 

@@ -18,9 +18,9 @@
 //! one call, before the cover could follow, so its grid takes in all its neighbours' nodes at
 //! its first edit, as a garden did for every tree before covers.
 
-use std::collections::HashSet;
-
 use glam::{IVec3, Vec3};
+
+use super::cell_hash::CellSet;
 
 use crate::Tree;
 use crate::environment::{MAX_SHADOW_DEPTH_VOXELS, floor_to_ivec3};
@@ -37,7 +37,7 @@ pub(crate) struct ShadeCover {
     /// is loaded again, which makes the cover anew.)
     pub(super) everywhere: bool,
     /// Cells that ever held a node of the tree.
-    node_cells: HashSet<IVec3>,
+    node_cells: CellSet,
     /// `node_cells`, each with the 26 around it.
     cells: Cells,
 }
@@ -52,7 +52,7 @@ impl PartialEq for ShadeCover {
 /// A set of cells with its bounding box (a cheap first test).
 #[derive(Clone, Debug)]
 pub(crate) struct Cells {
-    set: HashSet<IVec3>,
+    set: CellSet,
     lo: IVec3,
     hi: IVec3,
 }
@@ -60,7 +60,7 @@ pub(crate) struct Cells {
 impl Default for Cells {
     fn default() -> Cells {
         Cells {
-            set: HashSet::new(),
+            set: CellSet::default(),
             lo: IVec3::MAX,
             hi: IVec3::MIN,
         }

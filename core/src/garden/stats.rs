@@ -56,6 +56,32 @@ impl CrownStats {
         }
     }
 
+    /// [`CrownStats::radius_m`] of [`CrownStats::of`], the same bits, in one pass without the
+    /// centroid (no square roots): what the neighbourhood tropism asks of every tree each round.
+    pub(super) fn radius_only_m(t: &GardenTree) -> f32 {
+        let base = t.base();
+        let nodes = &t.tree.skeleton.internodes;
+        let has_branches = nodes.iter().any(|n| n.order >= 1);
+        let mut has_length = false;
+        let (mut lo, mut hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
+        for n in nodes.iter().filter(|n| n.order >= 1 || !has_branches) {
+            // A length sqrt(d) adds to a positive (or NaN) sum exactly when d is not <= 0.
+            let d = n.start.distance_squared(n.end);
+            has_length |= d > 0.0 || d.is_nan();
+            let e = Vec2::new(n.end.x, n.end.z);
+            lo = lo.min(e);
+            hi = hi.max(e);
+        }
+        let flat = Vec2::new(base.x, base.z);
+        let (lo, hi) = if has_length {
+            (lo + flat, hi + flat)
+        } else {
+            (flat, flat)
+        };
+        let extent = (hi - lo).max(Vec2::ZERO);
+        0.25 * (extent.x + extent.y)
+    }
+
     /// Horizontal offset of the crown's centroid from the trunk base (x, z), metres.
     pub fn offset(&self) -> Vec2 {
         Vec2::new(self.centroid.x - self.base.x, self.centroid.z - self.base.z)
