@@ -177,7 +177,12 @@ fn create_gfx(event_loop: &ActiveEventLoop, size: (u32, u32)) -> anyhow::Result<
         (size.width, size.height),
         window.scale_factor() as f32,
     )?;
-    let drawer = ViewDrawer::new(&gpu, surface.format());
+    let mut drawer = ViewDrawer::new(&gpu, surface.format());
+    // On a CPU rasteriser the AR view is drawn at the footage's resolution and stretched over
+    // the window.
+    drawer.set_scene_resolution(crate::render::upscale::interactive_scene_resolution(
+        &gpu.adapter.get_info(),
+    ));
     let egui_state = egui_winit::State::new(
         drawer.egui_ctx().clone(),
         egui::ViewportId::ROOT,

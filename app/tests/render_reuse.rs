@@ -1,7 +1,8 @@
 //! The renderer does its work once (issue 20, Done-when 6): the sun's shadow map is drawn again
 //! only when the tree, the sun or the drawn level change, not when the camera moves, and a frame
 //! drawn with the kept map is the frame a fresh renderer draws; the one-sample scene pass of an
-//! interactive view on a CPU rasteriser keeps the 4× frame's look (alpha-tested leaf edges).
+//! interactive view on a CPU rasteriser keeps the 4× frame's look (alpha-tested leaf edges), and
+//! so does its scene drawn at the footage's resolution and stretched over a larger window.
 //!
 //! Run: `XDG_RUNTIME_DIR=/tmp/sylva-xdg WGPU_BACKEND=vulkan cargo test --release -p sylva-app --test render_reuse`
 
@@ -9,7 +10,8 @@ use glam::Vec3;
 use image::{Rgba, RgbaImage};
 use sylva_app::render::offscreen::OFFSCREEN_FORMAT;
 use sylva_app::render::{
-    FrameView, Gpu, GroundPlane, Intrinsics, Offscreen, Renderer, TreeMesh, ViewCamera,
+    FrameView, Gpu, GroundPlane, Intrinsics, Offscreen, Renderer, SceneResolution, TreeMesh,
+    ViewCamera,
 };
 
 const WIDTH: u32 = 320;
@@ -136,5 +138,54 @@ fn one_sample_with_alpha_tested_leaves_keeps_the_look_of_the_multisampled_frame(
     assert!(
         black_b < covered_b / 100,
         "{black_b} black pixels at 1x ({black_a} at 4x) of {covered_b} drawn"
+    );
+}
+
+#[test]
+fn the_scene_at_the_footage_resolution_stretched_over_a_larger_window_keeps_its_look() {
+    let gpu = gpu();
+    let tree = sylva_app::tree_model::golden_tree_mesh();
+    // Twice the footage's height, wider than its aspect: the image is letterboxed.
+    let (width, height) = (2 * WIDTH + 100, 2 * HEIGHT);
+    let target = Offscreen::new(&gpu.device, width, height);
+    let view = view_from(&tree, Vec3::new(0.0, 2.5, -2.2));
+    assert_eq!(
+        SceneResolution::Footage.reduced_size((width, height), &intrinsics()),
+        Some((WIDTH, HEIGHT))
+    );
+    let mut full = renderer(&gpu, &tree, 1);
+    let mut reduced = renderer(&gpu, &tree, 1);
+    reduced.set_scene_resolution(SceneResolution::Footage);
+    let a = target.render(&gpu, &mut full, &view).expect("frame");
+    let b = target.render(&gpu, &mut reduced, &view).expect("frame");
+    let background = Rgba([150, 150, 150, 255]);
+    let near = |p: &Rgba<u8>, q: Rgba<u8>| p.0.iter().zip(q.0).all(|(x, y)| x.abs_diff(y) <= 2);
+    let covered = |image: &RgbaImage| {
+        image
+            .enumerate_pixels()
+            .filter(|(x, _, p)| (50..width - 50).contains(x) && !near(p, background))
+            .count()
+    };
+    let (covered_a, covered_b) = (covered(&a), covered(&b));
+    let differing = num_differing(&a, &b, 24);
+    println!(
+        "full resolution covers {covered_a} px, footage resolution {covered_b} px; \
+         {differing} px differ by more than 24"
+    );
+    assert!(covered_a > 8000, "the tree and its shadow are in view");
+    // The letterbox bars stay black; the image fills the region between them.
+    for image in [&a, &b] {
+        assert_eq!(image.get_pixel(10, height / 2).0, [0, 0, 0, 255]);
+        assert!(near(image.get_pixel(60, 3), background));
+        assert!(near(image.get_pixel(width - 60, 3), background));
+    }
+    assert!(
+        (covered_b as f64 - covered_a as f64).abs() < 0.1 * covered_a as f64,
+        "{covered_b} px drawn at the footage's resolution against {covered_a} at full"
+    );
+    // Only edges differ (softer where stretched): the same crown, shadow and colours.
+    assert!(
+        differing < covered_a / 3,
+        "{differing} of {covered_a} drawn pixels differ"
     );
 }

@@ -69,6 +69,11 @@ impl ViewDrawer {
         self.renderer.color_format()
     }
 
+    /// Draws the AR view at `resolution` (see [`crate::render::SceneResolution`]).
+    pub fn set_scene_resolution(&mut self, resolution: crate::render::SceneResolution) {
+        self.renderer.set_scene_resolution(resolution);
+    }
+
     /// Draws the shown frame and the UI (fed `raw` input; its events go to the player) into
     /// `target` of `size` pixels and submits the work; returns the UI's platform output.
     pub fn draw(

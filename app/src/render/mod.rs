@@ -27,6 +27,7 @@ pub mod resources;
 pub mod shadow;
 pub mod textures;
 mod tree_gpu;
+pub mod upscale;
 
 pub use camera::{Intrinsics, ViewCamera};
 pub use gpu::Gpu;
@@ -36,6 +37,7 @@ pub use mesh::{
 pub use offscreen::Offscreen;
 pub use pipelines::{SAMPLE_COUNT, interactive_sample_count};
 pub use resources::Renderer;
+pub use upscale::SceneResolution;
 
 use glam::Vec3;
 

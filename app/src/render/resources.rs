@@ -9,6 +9,7 @@ use crate::render::mesh::{OccluderMesh, TreeMesh};
 use crate::render::pipelines::{DEPTH_FORMAT, Pipelines, SAMPLE_COUNT};
 use crate::render::shadow::{GroundPatch, shadow_footprint, sun_clip_from_world};
 use crate::render::tree_gpu::{GpuTree, TreePipelines};
+use crate::render::upscale::{SceneResolution, Upscaler};
 use crate::render::{FrameView, Gpu, GroundStyle};
 
 /// The camera a frame picks each tree's level of detail for, and its focal length in pixels.
@@ -90,6 +91,10 @@ pub struct Renderer {
     /// The scene pass's targets.
     targets: Option<SceneTargets>,
     color_format: wgpu::TextureFormat,
+    /// The resolution the scene pass draws at (full in offscreen frames).
+    scene_resolution: SceneResolution,
+    /// The reduced-resolution scene target and its stretch pass (made when first needed).
+    upscaler: Option<Upscaler>,
 }
 
 /// The scene pass's own targets for one size: the multisampled colour (resolved into the
@@ -212,7 +217,19 @@ impl Renderer {
             points: None,
             targets: None,
             color_format,
+            scene_resolution: SceneResolution::Full,
+            upscaler: None,
         }
+    }
+
+    /// Draws the scene at `resolution` from the next frame on ([`SceneResolution::Full`] by
+    /// default; [`SceneResolution::Footage`] for an interactive view on a CPU rasteriser).
+    pub fn set_scene_resolution(&mut self, resolution: SceneResolution) {
+        self.scene_resolution = resolution;
+    }
+
+    pub fn scene_resolution(&self) -> SceneResolution {
+        self.scene_resolution
     }
 
     pub fn color_format(&self) -> wgpu::TextureFormat {
@@ -410,8 +427,35 @@ impl Renderer {
         });
     }
 
-    /// Records one frame into `target` (of `size` pixels, this renderer's colour format).
+    /// Records one frame into `target` (of `size` pixels, this renderer's colour format): at
+    /// the target's resolution, or at the camera image's and stretched over the drawn region
+    /// (see [`Self::set_scene_resolution`]).
     pub fn render(
+        &mut self,
+        gpu: &Gpu,
+        encoder: &mut wgpu::CommandEncoder,
+        target: &wgpu::TextureView,
+        size: (u32, u32),
+        view: &FrameView,
+    ) {
+        let Some(scene_size) = self
+            .scene_resolution
+            .reduced_size(size, &view.camera.intrinsics)
+        else {
+            return self.render_direct(gpu, encoder, target, size, view);
+        };
+        let mut upscaler = self
+            .upscaler
+            .take()
+            .unwrap_or_else(|| Upscaler::new(&gpu.device, self.color_format));
+        let scene = upscaler.scene_target(&gpu.device, scene_size, self.color_format);
+        self.render_direct(gpu, encoder, &scene, scene_size, view);
+        upscaler.stretch(encoder, target, letterbox(size, &view.camera.intrinsics));
+        self.upscaler = Some(upscaler);
+    }
+
+    /// Records one frame into `target` of `size` pixels, at that resolution.
+    fn render_direct(
         &mut self,
         gpu: &Gpu,
         encoder: &mut wgpu::CommandEncoder,
