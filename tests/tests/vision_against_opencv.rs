@@ -8,7 +8,9 @@ use sylva_tests::shared_data_dir;
 use sylva_tracking::sequence::decode_gray;
 use sylva_tracking::{GrayImage, TumSequence, cv, lk, vision};
 
-fn frames(pairs: impl Iterator<Item = (usize, usize)>) -> (TumSequence, Vec<(GrayImage, GrayImage)>) {
+fn frames(
+    pairs: impl Iterator<Item = (usize, usize)>,
+) -> (TumSequence, Vec<(GrayImage, GrayImage)>) {
     let root = shared_data_dir().join("tum_fr1_rpy");
     let sequence = TumSequence::open(&root).expect("fr1_rpy opens");
     let images = pairs
@@ -37,9 +39,15 @@ fn portable_corners_are_opencvs() {
             .filter(|c| ours.iter().any(|o| o.distance(**c) < 0.5))
             .count();
     }
-    let summary = format!("ours {} / OpenCV {}, same pixel {matched}", counts.0, counts.1);
+    let summary = format!(
+        "ours {} / OpenCV {}, same pixel {matched}",
+        counts.0, counts.1
+    );
     println!("{summary}");
-    assert!(counts.0.abs_diff(counts.1) * 100 <= counts.1 * 2, "{summary}");
+    assert!(
+        counts.0.abs_diff(counts.1) * 100 <= counts.1 * 2,
+        "{summary}"
+    );
     assert!(matched * 100 >= total * 95, "{summary}");
 }
 
@@ -70,35 +78,49 @@ fn tracked_pairs(sequence: &TumSequence, a: &GrayImage, b: &GrayImage) -> (Vec<D
         .unzip()
 }
 
+/// Both backends' relative rotations against the ground truth's, on pairs six frames apart:
+/// short baselines of a mostly rotating camera, where the essential matrix is poorly
+/// conditioned and neither backend is the truth.
 #[test]
-fn portable_two_view_geometry_agrees_with_opencv() {
-    let (sequence, images) = frames((20..700).step_by(40).map(|i| (i, i + 6)));
+fn portable_two_view_geometry_is_as_good_as_opencvs() {
+    let pairs: Vec<(usize, usize)> = (20..700).step_by(40).map(|i| (i, i + 6)).collect();
+    let (sequence, images) = frames(pairs.iter().copied());
     let camera = sequence.camera;
-    let mut rotation_gaps = Vec::new();
+    let (mut ours_err, mut theirs_err) = (Vec::new(), Vec::new());
     let mut homography = (0usize, 0usize);
-    for (a, b) in &images {
+    for (&(i, j), (a, b)) in pairs.iter().zip(&images) {
         let (first, second) = tracked_pairs(&sequence, a, b);
+        let truth = |k: usize| sequence.groundtruth_at(sequence.frames[k].timestamp_s, 0.05);
+        let (Some(ga), Some(gb)) = (truth(i), truth(j)) else {
+            continue;
+        };
+        // second_from_first = (world_from_second)⁻¹ · world_from_first.
+        let relative = glam::DQuat::from_mat3(&(gb.inverse() * ga).matrix3).normalize();
         let theirs = cv::relative_pose(&camera, &first, &second, 1.0).expect("OpenCV");
         let ours = vision::relative_pose(&camera, &first, &second, 1.0);
         if let (Some((t, _)), Some((o, _))) = (theirs, ours) {
-            rotation_gaps.push(o.rotation.angle_between(t.rotation).to_degrees());
+            ours_err.push(o.rotation.angle_between(relative).to_degrees());
+            theirs_err.push(t.rotation.angle_between(relative).to_degrees());
         }
         homography.0 += vision::homography_inliers(&camera, &first, &second, 1.0);
         homography.1 += cv::homography_inliers(&camera, &first, &second, 1.0).expect("OpenCV");
     }
-    rotation_gaps.sort_by(f64::total_cmp);
-    let median = rotation_gaps[rotation_gaps.len() / 2];
+    let median = |mut v: Vec<f64>| {
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    let n = ours_err.len();
+    let (ours, theirs) = (median(ours_err), median(theirs_err));
     let summary = format!(
-        "{} pairs, rotation gap median {median:.3}°, max {:.3}°; homography inliers ours {} / OpenCV {}",
-        rotation_gaps.len(),
-        rotation_gaps.last().copied().unwrap_or(0.0),
-        homography.0,
-        homography.1
+        "{n} pairs, rotation error against ground truth: median ours {ours:.3}°, OpenCV {theirs:.3}°; homography inliers ours {} / OpenCV {}",
+        homography.0, homography.1
     );
     println!("{summary}");
-    assert!(rotation_gaps.len() >= 15, "{summary}");
-    assert!(median < 0.1, "{summary}");
-    assert!(homography.0.abs_diff(homography.1) * 100 <= homography.1 * 5, "{summary}");
+    assert!(n >= 15, "{summary}");
+    assert!(ours <= 1.25 * theirs + 0.05, "{summary}");
+    // Model selection compares the homography's consensus with the essential matrix's: the
+    // portable RANSAC must find at least OpenCV's.
+    assert!(homography.0 * 100 >= homography.1 * 95, "{summary}");
 }
 
 #[test]
@@ -112,7 +134,9 @@ fn portable_pnp_finds_opencvs_pose() {
     let inverse = truth.inverse();
     let mut state = 12345u64;
     let mut unit = || {
-        state = state.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        state = state
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         (state >> 11) as f64 / (1u64 << 53) as f64
     };
     let (mut world, mut image) = (Vec::new(), Vec::new());
@@ -138,6 +162,10 @@ fn portable_pnp_finds_opencvs_pose() {
         let shift = (ours.translation - theirs.translation).length();
         assert!(gap < 0.1 && shift < 0.005, "{minimal:?}: {gap}° {shift} m");
         assert!(ours.rotation.angle_between(truth.rotation).to_degrees() < 0.1);
-        assert!(inliers.len() >= 95, "{minimal:?}: {} inliers", inliers.len());
+        assert!(
+            inliers.len() >= 95,
+            "{minimal:?}: {} inliers",
+            inliers.len()
+        );
     }
 }

@@ -111,7 +111,11 @@ fn bench_tracking(c: &mut Criterion) {
     let mut times: Vec<Vec<Duration>> = vec![Vec::with_capacity(frames.len()); backends.len()];
     for (i, frame) in frames.iter().enumerate() {
         for k in 0..backends.len() {
-            let k = if i % 2 == 0 { k } else { backends.len() - 1 - k };
+            let k = if i % 2 == 0 {
+                k
+            } else {
+                backends.len() - 1 - k
+            };
             let start = Instant::now();
             let output = trackers[k].track(frame, ups[i].map(|u| u * 9.81));
             times[k].push(start.elapsed());

@@ -121,12 +121,7 @@ impl Vision {
         match self {
             #[cfg(feature = "opencv")]
             Self::OpenCv(_) => Ok(cv::relative_pose(camera, first, second, threshold_px)?),
-            Self::Portable(_) => Ok(vision::relative_pose(
-                camera,
-                first,
-                second,
-                threshold_px,
-            )),
+            Self::Portable(_) => Ok(vision::relative_pose(camera, first, second, threshold_px)),
         }
     }
 
@@ -140,12 +135,7 @@ impl Vision {
     ) -> Result<usize, TrackerError> {
         match self {
             #[cfg(feature = "opencv")]
-            Self::OpenCv(_) => Ok(cv::homography_inliers(
-                camera,
-                first,
-                second,
-                threshold_px,
-            )?),
+            Self::OpenCv(_) => Ok(cv::homography_inliers(camera, first, second, threshold_px)?),
             Self::Portable(_) => Ok(vision::homography_inliers(
                 camera,
                 first,

@@ -44,10 +44,10 @@ pub mod report;
 pub mod tracker;
 pub mod vision;
 
+pub use backend::VisionBackend;
 pub use camera::{Camera, CameraError};
 pub use frame::{Frame, FrameOutput, GrayImage, Plane, TrackedPoint, TrackingState};
 pub use sequence::{FrameSource, SequenceError, SourceEvent, TumSequence};
-pub use backend::VisionBackend;
 pub use tracker::{Tracker, TrackerConfig, TrackerError};
 
 pub mod depth_mesh;

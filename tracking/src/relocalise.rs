@@ -6,12 +6,12 @@
 //! keyframe's image: many more correspondences, sub-pixel, where the view is near a keyframe's.
 
 use crate::ba::refine_pose;
-use crate::vision;
 use crate::features::{Track, normalized};
 use crate::frame::{Frame, TrackingState};
 use crate::lk::{self, Pyramid};
 use crate::pose::Se3;
 use crate::tracker::{Tracker, TrackerError};
+use crate::vision;
 use glam::{DVec2, DVec3, Vec2};
 use std::collections::BTreeMap;
 

@@ -4,8 +4,8 @@
 //! relocalisation (module `relocalise`).
 
 use crate::ba::{BaConfig, refine_pose, reprojection_error_px};
-use crate::camera::Camera;
 use crate::backend::{Vision, VisionBackend};
+use crate::camera::Camera;
 #[cfg(feature = "opencv")]
 use crate::cv::CvError;
 use crate::features::{Track, normalized};

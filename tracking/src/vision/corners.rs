@@ -117,8 +117,7 @@ pub fn detect_corners(
             if v <= threshold || !allowed[i] {
                 continue;
             }
-            let is_max = (y - 1..=y + 1)
-                .all(|yy| (x - 1..=x + 1).all(|xx| eig[yy * w + xx] <= v));
+            let is_max = (y - 1..=y + 1).all(|yy| (x - 1..=x + 1).all(|xx| eig[yy * w + xx] <= v));
             if is_max {
                 candidates.push((v, i));
             }
@@ -147,8 +146,11 @@ pub fn detect_corners(
         let p = Vec2::new((i % w) as f32, (i / w) as f32);
         let (gx, gy) = ((p.x / cell) as usize, (p.y / cell) as usize);
         let near = (gy.saturating_sub(1)..=(gy + 1).min(gh - 1)).any(|cy| {
-            (gx.saturating_sub(1)..=(gx + 1).min(gw - 1))
-                .any(|cx| grid[cy * gw + cx].iter().any(|q| (*q - p).length_squared() < min_d2))
+            (gx.saturating_sub(1)..=(gx + 1).min(gw - 1)).any(|cx| {
+                grid[cy * gw + cx]
+                    .iter()
+                    .any(|q| (*q - p).length_squared() < min_d2)
+            })
         });
         if near {
             continue;

@@ -442,9 +442,18 @@ mod tests {
     #[test]
     fn relative_pose_recovers_a_known_motion_despite_outliers() {
         for (seed, motion) in [
-            (1, Se3::new(DQuat::from_rotation_y(0.1), DVec3::new(-0.4, 0.05, 0.1))),
-            (2, Se3::new(DQuat::from_rotation_x(-0.05), DVec3::new(0.0, 0.0, -0.3))),
-            (3, Se3::new(DQuat::from_rotation_z(0.2), DVec3::new(0.3, -0.2, 0.0))),
+            (
+                1,
+                Se3::new(DQuat::from_rotation_y(0.1), DVec3::new(-0.4, 0.05, 0.1)),
+            ),
+            (
+                2,
+                Se3::new(DQuat::from_rotation_x(-0.05), DVec3::new(0.0, 0.0, -0.3)),
+            ),
+            (
+                3,
+                Se3::new(DQuat::from_rotation_z(0.2), DVec3::new(0.3, -0.2, 0.0)),
+            ),
         ] {
             let (a, mut b) = scene(&motion, 200, seed);
             // A quarter of the matches wrong.
@@ -458,9 +467,15 @@ mod tests {
             // pull the refit a little: a thousandth of a radian.
             let angle = pose.rotation.angle_between(motion.rotation);
             let shift = (pose.translation - t).length();
-            assert!(angle < 1e-3 && shift < 1e-2, "seed {seed}: {angle} rad, {shift}");
+            assert!(
+                angle < 1e-3 && shift < 1e-2,
+                "seed {seed}: {angle} rad, {shift}"
+            );
             let inliers = mask.iter().filter(|&&m| m).count();
-            assert!(mask[50..].iter().all(|&m| m), "seed {seed}: clean points are inliers");
+            assert!(
+                mask[50..].iter().all(|&m| m),
+                "seed {seed}: clean points are inliers"
+            );
             assert!(inliers <= 160, "seed {seed}: {inliers} inliers");
         }
     }
@@ -507,6 +522,9 @@ mod tests {
         let (found, mask) = find_homography(&p1, &p2, 1.0).expect("homography");
         assert!(mask[20..].iter().all(|&m| m) && mask[..20].iter().all(|&m| !m));
         let (found, h) = (found / found.col(2).z, h);
-        assert!((found - h).to_cols_array().iter().all(|d| d.abs() < 1e-6), "{found}");
+        assert!(
+            (found - h).to_cols_array().iter().all(|d| d.abs() < 1e-6),
+            "{found}"
+        );
     }
 }

@@ -181,7 +181,10 @@ mod tests {
             })
             .collect();
         let norm = truth.iter().map(|v| v * v).sum::<f64>().sqrt();
-        for x in [null_vector_9(&rows).expect("rank 8"), least_squares_null_9(&rows).expect("ls")] {
+        for x in [
+            null_vector_9(&rows).expect("rank 8"),
+            least_squares_null_9(&rows).expect("ls"),
+        ] {
             let dot: f64 = x.iter().zip(&truth).map(|(a, b)| a * b / norm).sum();
             assert!((dot.abs() - 1.0).abs() < 1e-9, "dot {dot}");
         }

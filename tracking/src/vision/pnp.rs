@@ -139,9 +139,15 @@ pub fn p3p(world: [DVec3; 3], image: [DVec2; 3]) -> Vec<Se3> {
     // Their Sylvester resultant (divided by b²): b² (C2 − C1)² − (B2 − B1)(B1 C2 − B2 C1).
     let dc = poly_sub(&c_second, &c_first);
     let db = poly_sub(&b_second, &b_first);
-    let cross = poly_sub(&poly_mul(&b_first, &c_second), &poly_mul(&b_second, &c_first));
+    let cross = poly_sub(
+        &poly_mul(&b_first, &c_second),
+        &poly_mul(&b_second, &c_first),
+    );
     let quartic = poly_sub(
-        &poly_mul(&dc, &dc).iter().map(|x| x * b2).collect::<Vec<_>>(),
+        &poly_mul(&dc, &dc)
+            .iter()
+            .map(|x| x * b2)
+            .collect::<Vec<_>>(),
         &poly_mul(&db, &cross),
     );
     let mut poses = Vec::new();
@@ -250,7 +256,12 @@ pub fn pnp_ransac(
         let (cost, count) = score(&pose);
         if best.as_ref().is_none_or(|b| cost < b.0) {
             best = Some((cost, count, pose));
-            limit = ransac_iterations(CONFIDENCE, count as f64 / n as f64, sample_size, max_iterations);
+            limit = ransac_iterations(
+                CONFIDENCE,
+                count as f64 / n as f64,
+                sample_size,
+                max_iterations,
+            );
         }
     }
     let (_, _, mut pose) = best?;
@@ -357,9 +368,15 @@ mod tests {
             }
             let (pose, inliers) =
                 pnp_ransac(&camera, &w, &m, None, 2.0, 1000, minimal).expect("pose");
-            assert!(pose.rotation.angle_between(truth.rotation) < 2e-3, "{minimal:?}");
+            assert!(
+                pose.rotation.angle_between(truth.rotation) < 2e-3,
+                "{minimal:?}"
+            );
             assert!((pose.translation - truth.translation).length() < 5e-3);
-            assert!(inliers.iter().filter(|&&i| i >= 40).count() == 80, "{minimal:?}");
+            assert!(
+                inliers.iter().filter(|&&i| i >= 40).count() == 80,
+                "{minimal:?}"
+            );
             assert!(inliers.len() <= 84, "{minimal:?}: {}", inliers.len());
         }
         // Too few points: no pose.
