@@ -264,15 +264,7 @@ pub fn homography_inliers(
         .unwrap_or(0))
 }
 
-/// The minimal solver [`pnp_ransac`] runs on each hypothesis.
-#[derive(Clone, Copy, Debug, PartialEq, Eq)]
-pub enum PnpMinimal {
-    /// EPnP on five points.
-    Epnp,
-    /// Algebraic P3P on four points (three and one to choose among the solutions): several
-    /// times cheaper than EPnP's SVD, for the thousand hypotheses of relocalisation.
-    Ap3p,
-}
+pub use crate::vision::PnpMinimal;
 
 /// Camera pose from 2D–3D correspondences inside RANSAC (the inliers refined by EPnP):
 /// `camera_from_world` and the inlier indices. Image points are normalised undistorted
@@ -334,8 +326,7 @@ pub struct OrbFeatures {
     orb: core::Ptr<features2d::ORB>,
 }
 
-/// A 256-bit ORB descriptor.
-pub type Descriptor = [u8; 32];
+pub use crate::vision::{Descriptor, NearestTwo, hamming};
 
 impl OrbFeatures {
     pub fn new(max_features: usize) -> Result<Self> {
@@ -402,7 +393,7 @@ impl OrbFeatures {
             // ORB takes provided keypoints' angles as they are: give each the intensity-centroid
             // orientation detection would have found, or its descriptor would not match the
             // same corner detected in another frame.
-            let Some(angle) = intensity_centroid_angle_deg(image, *p) else {
+            let Some(angle) = crate::vision::orb::intensity_centroid_angle_deg(image, *p) else {
                 continue;
             };
             keypoints.push(KeyPoint::new_coords(
@@ -417,75 +408,6 @@ impl OrbFeatures {
             }
         }
         Ok(out)
-    }
-}
-
-/// Radius of ORB's orientation patch (half its 31-pixel patch).
-const ORIENTATION_RADIUS: i32 = 15;
-
-/// Orientation of the intensity centroid (Rosin's moments m₁₀, m₀₁ over a disc of radius 15
-/// around `p`), in degrees in [0, 360) as ORB measures it. None too near the border.
-fn intensity_centroid_angle_deg(image: &GrayImage, p: Vec2) -> Option<f32> {
-    let (cx, cy) = (p.x.round() as i32, p.y.round() as i32);
-    let (w, h) = (image.width as i32, image.height as i32);
-    let r = ORIENTATION_RADIUS;
-    if cx < r || cy < r || cx + r >= w || cy + r >= h {
-        return None;
-    }
-    let (mut m10, mut m01) = (0i64, 0i64);
-    for v in -r..=r {
-        let half = ((r * r - v * v) as f32).sqrt().round() as i32;
-        let row = ((cy + v) * w) as usize;
-        for u in -half..=half {
-            let value = i64::from(image.pixels[row + (cx + u) as usize]);
-            m10 += i64::from(u) * value;
-            m01 += i64::from(v) * value;
-        }
-    }
-    let angle = (m01 as f32).atan2(m10 as f32).to_degrees();
-    Some(if angle < 0.0 { angle + 360.0 } else { angle })
-}
-
-/// Hamming distance between two ORB descriptors.
-pub fn hamming(a: &Descriptor, b: &Descriptor) -> u32 {
-    a.iter().zip(b).map(|(x, y)| (x ^ y).count_ones()).sum()
-}
-
-/// The nearest and second-nearest of the descriptors offered, for Lowe's ratio test.
-pub struct NearestTwo<T> {
-    best: u32,
-    second: u32,
-    best_item: Option<T>,
-}
-
-impl<T> Default for NearestTwo<T> {
-    fn default() -> Self {
-        Self {
-            best: u32::MAX,
-            second: u32::MAX,
-            best_item: None,
-        }
-    }
-}
-
-impl<T> NearestTwo<T> {
-    /// Offers `item` at Hamming `distance`; the first of equals stays the nearest.
-    pub fn offer(&mut self, distance: u32, item: T) {
-        if distance < self.best {
-            self.second = self.best;
-            self.best = distance;
-            self.best_item = Some(item);
-        } else if distance < self.second {
-            self.second = distance;
-        }
-    }
-
-    /// The nearest and its distance, when within `max_hamming` and clearly nearer than the
-    /// second (`best < ratio · second`; a lone candidate passes).
-    pub fn accepted(self, max_hamming: u32, ratio: f64) -> Option<(T, u32)> {
-        let item = self.best_item?;
-        let clear = self.second == u32::MAX || (self.best as f64) < ratio * self.second as f64;
-        (self.best <= max_hamming && clear).then_some((item, self.best))
     }
 }
 

@@ -58,7 +58,7 @@ impl Tracker {
             return Ok(0);
         }
         let pixels: Vec<Vec2> = candidates.iter().map(|&i| self.tracks[i].pixel).collect();
-        let described = match self.orb.describe(image, &pixels) {
+        let described = match self.vision.describe(image, &pixels) {
             Ok(d) => d,
             Err(_) => return Ok(0),
         };
@@ -70,7 +70,7 @@ impl Tracker {
             let Some(descriptor) = descriptor else {
                 continue;
             };
-            let mut nearest = crate::cv::NearestTwo::default();
+            let mut nearest = crate::vision::NearestTwo::default();
             let (cx, cy) = cell(*pixel);
             for dy in -1..=1 {
                 for dx in -1..=1 {
@@ -79,7 +79,7 @@ impl Tracker {
                     };
                     for (id, projected, d) in list {
                         if projected.distance(*pixel) <= self.config.adopt_radius_px {
-                            nearest.offer(crate::cv::hamming(&descriptor, d), *id);
+                            nearest.offer(crate::vision::hamming(&descriptor, d), *id);
                         }
                     }
                 }

@@ -4,7 +4,6 @@
 //! meanwhile get their poses once the map exists (late poses).
 
 use crate::ba::{BaObservation, bundle_adjust, refine_pose, reprojection_error_px};
-use crate::cv;
 use crate::features::{Track, normalized, parallax_rad, triangulate};
 use crate::frame::{Frame, TrackingState};
 use crate::lk::{self, Pyramid};
@@ -33,7 +32,9 @@ impl Tracker {
         frame: &Frame,
         pyramid: Pyramid,
     ) -> Result<(), TrackerError> {
-        let corners = cv::detect_corners(&frame.image, 2 * self.config.max_tracks, 10.0, &[])?;
+        let corners =
+            self.vision
+                .detect_corners(&frame.image, 2 * self.config.max_tracks, 10.0, &[])?;
         if corners.len() < MIN_INIT_TRACKS {
             self.state = TrackingState::NotInitialized;
             return Ok(());
@@ -127,7 +128,9 @@ impl Tracker {
         }
         let first: Vec<DVec2> = pairs.iter().map(|p| p.1).collect();
         let second: Vec<DVec2> = pairs.iter().map(|p| p.2).collect();
-        let Some((relative, inliers)) = cv::relative_pose(&self.camera, &first, &second, 1.0)?
+        let Some((relative, inliers)) =
+            self.vision
+                .relative_pose(&self.camera, &first, &second, 1.0)?
         else {
             return Ok(None);
         };
@@ -159,7 +162,9 @@ impl Tracker {
         }
         // Homography-versus-essential model selection: a homography explaining nearly all
         // essential inliers means rotation or a plane seen without enough depth spread.
-        let homography = cv::homography_inliers(&self.camera, &first, &second, 1.0)?;
+        let homography = self
+            .vision
+            .homography_inliers(&self.camera, &first, &second, 1.0)?;
         if homography as f64 > 0.95 * num_inliers as f64
             && median_parallax < 2.0 * self.config.init_min_parallax_deg
         {

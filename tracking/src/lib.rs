@@ -11,8 +11,9 @@
 //! picked with [`measure`]) is the one factor that corrects them, as [`run_scale`] does for a run.
 //!
 //! **Features.** `opencv` (default on desktop): feature tracking, PnP and video readers through
-//! OpenCV; OpenCV types never leave the `cv` module. Without it, the plane, scale, map and depth
-//! mesh still build (mobile targets).
+//! OpenCV; OpenCV types never leave the `cv` module. Without it (mobile targets) the tracker
+//! still builds and runs on the portable vision backend ([`vision`], chosen by
+//! [`TrackerConfig::backend`], selectable on desktop too); only the video readers need OpenCV.
 
 pub mod ba;
 pub mod camera;
@@ -32,25 +33,21 @@ pub mod scale;
 pub mod sequence;
 pub mod world;
 
+mod backend;
 #[cfg(feature = "opencv")]
 pub mod cv;
-#[cfg(feature = "opencv")]
 mod fusion;
-#[cfg(feature = "opencv")]
 mod initializer;
-#[cfg(feature = "opencv")]
 mod mapping;
-#[cfg(feature = "opencv")]
 mod relocalise;
-#[cfg(feature = "opencv")]
 pub mod report;
-#[cfg(feature = "opencv")]
 pub mod tracker;
+pub mod vision;
 
+pub use backend::VisionBackend;
 pub use camera::{Camera, CameraError};
 pub use frame::{Frame, FrameOutput, GrayImage, Plane, TrackedPoint, TrackingState};
 pub use sequence::{FrameSource, SequenceError, SourceEvent, TumSequence};
-#[cfg(feature = "opencv")]
 pub use tracker::{Tracker, TrackerConfig, TrackerError};
 
 pub mod depth_mesh;

@@ -3,7 +3,6 @@
 //! keyframe that saw each point, and local bundle adjustment over recent keyframes.
 
 use crate::ba::{BaObservation, bundle_adjust, reprojection_error_px};
-use crate::cv;
 use crate::features::{Track, TrackOrigin, parallax_rad, triangulate};
 use crate::frame::{Frame, GrayImage};
 use crate::lk::{self, Pyramid};
@@ -174,7 +173,7 @@ impl Tracker {
             return Ok(());
         }
         let existing: Vec<Vec2> = self.tracks.iter().map(|t| t.pixel).collect();
-        let corners = cv::detect_corners(
+        let corners = self.vision.detect_corners(
             &frame.image,
             wanted,
             self.config.min_corner_distance_px,
@@ -210,7 +209,7 @@ impl Tracker {
             .collect();
         let pixels: Vec<Vec2> = seen.iter().map(|s| s.1).collect();
         // Descriptors only help relocalisation; failing to compute them is not a tracking error.
-        let Ok(descriptors) = self.orb.describe(image, &pixels) else {
+        let Ok(descriptors) = self.vision.describe(image, &pixels) else {
             return;
         };
         for ((id, _), d) in seen.iter().zip(descriptors) {

@@ -6,12 +6,12 @@
 //! keyframe's image: many more correspondences, sub-pixel, where the view is near a keyframe's.
 
 use crate::ba::refine_pose;
-use crate::cv;
 use crate::features::{Track, normalized};
 use crate::frame::{Frame, TrackingState};
 use crate::lk::{self, Pyramid};
 use crate::pose::Se3;
 use crate::tracker::{Tracker, TrackerError};
+use crate::vision;
 use glam::{DVec2, DVec3, Vec2};
 use std::collections::BTreeMap;
 
@@ -48,12 +48,12 @@ impl Tracker {
         if described.len() < 30 {
             return Ok(None);
         }
-        let features = self.orb.describe_corners(&frame.image, 1000, 7.0)?;
+        let features = self.vision.describe_corners(&frame.image, 1000, 7.0)?;
         let mut matches: Correspondences = Vec::new();
         for (pixel, descriptor) in &features {
-            let mut nearest = cv::NearestTwo::default();
+            let mut nearest = vision::NearestTwo::default();
             for (k, (_, _, d)) in described.iter().enumerate() {
-                nearest.offer(cv::hamming(descriptor, d), k);
+                nearest.offer(vision::hamming(descriptor, d), k);
             }
             if let Some((k, _)) = nearest.accepted(MAX_HAMMING, RATIO) {
                 matches.push((described[k].0, described[k].1, *pixel));
@@ -178,10 +178,10 @@ impl Tracker {
         // Once lost, this runs on every frame until it succeeds: the four-point solver keeps
         // each attempt cheap (and needs fewer hypotheses at a given inlier ratio).
         let minimal = match self.state {
-            TrackingState::RecentlyLost | TrackingState::Lost => cv::PnpMinimal::Ap3p,
-            _ => cv::PnpMinimal::Epnp,
+            TrackingState::RecentlyLost | TrackingState::Lost => vision::PnpMinimal::Ap3p,
+            _ => vision::PnpMinimal::Epnp,
         };
-        Ok(cv::pnp_ransac(
+        self.vision.pnp_ransac(
             &self.camera,
             &world,
             &image,
@@ -189,6 +189,6 @@ impl Tracker {
             THRESHOLD_PX,
             HYPOTHESES,
             minimal,
-        )?)
+        )
     }
 }

@@ -4,8 +4,10 @@
 //! relocalisation (module `relocalise`).
 
 use crate::ba::{BaConfig, refine_pose, reprojection_error_px};
+use crate::backend::{Vision, VisionBackend};
 use crate::camera::Camera;
-use crate::cv::{self, CvError, OrbFeatures};
+#[cfg(feature = "opencv")]
+use crate::cv::CvError;
 use crate::features::{Track, normalized};
 use crate::frame::{Frame, FrameOutput, Plane, TrackedPoint, TrackingState};
 use crate::initializer::Initializer;
@@ -17,11 +19,15 @@ use crate::world::WorldFrame;
 use glam::{DAffine3, DVec2, DVec3, Vec2};
 use std::collections::{HashMap, HashSet};
 
-/// Tracking failed in a way that is not about the footage (an OpenCV error).
+/// Tracking failed in a way that is not about the footage (an OpenCV error, or a backend this
+/// build lacks).
 #[derive(Debug, thiserror::Error)]
 pub enum TrackerError {
+    #[cfg(feature = "opencv")]
     #[error(transparent)]
     Cv(#[from] CvError),
+    #[error("this build has no {} vision backend (it needs the `opencv` feature)", .0.name())]
+    BackendUnavailable(VisionBackend),
 }
 
 /// Tracker settings; defaults suit 640 × 480 handheld footage at 30 Hz.
@@ -77,6 +83,9 @@ pub struct TrackerConfig {
     pub lost_after_frames: usize,
     /// Holding height for the metric scale, metres. Default 1.5.
     pub holding_height_m: f64,
+    /// Corners, two-view geometry, PnP and ORB: OpenCV or the portable backend. Default
+    /// OpenCV where the build has it, else portable.
+    pub backend: VisionBackend,
 }
 
 impl Default for TrackerConfig {
@@ -103,6 +112,7 @@ impl Default for TrackerConfig {
             rolling_shutter_readout_s: None,
             lost_after_frames: 30,
             holding_height_m: crate::scale::DEFAULT_HOLDING_HEIGHT_M,
+            backend: VisionBackend::default(),
         }
     }
 }
@@ -139,13 +149,13 @@ pub struct Tracker {
     pub(crate) world: Option<WorldFrame>,
     pub(crate) gravity_up: Option<DVec3>,
     pub(crate) late_poses: Vec<LatePose>,
-    pub(crate) orb: OrbFeatures,
+    pub(crate) vision: Vision,
     pub(crate) readout: ReadoutEstimate,
 }
 
 impl Tracker {
     pub fn new(camera: Camera, config: TrackerConfig) -> Result<Self, TrackerError> {
-        cv::configure_single_thread();
+        let vision = Vision::new(config.backend)?;
         Ok(Self {
             camera,
             config,
@@ -166,7 +176,7 @@ impl Tracker {
             world: None,
             gravity_up: None,
             late_poses: Vec::new(),
-            orb: OrbFeatures::new(1000)?,
+            vision,
             readout: ReadoutEstimate::default(),
         })
     }
@@ -413,14 +423,14 @@ impl Tracker {
                 .count()
         };
         if count(&pose) * 2 < pairs.len() {
-            match cv::pnp_ransac(
+            match self.vision.pnp_ransac(
                 &self.camera,
                 &world,
                 &image,
                 Some(start),
                 self.config.outlier_px as f32,
                 100,
-                cv::PnpMinimal::Epnp,
+                crate::vision::PnpMinimal::Epnp,
             )? {
                 Some((found, _)) => pose = refine_pose(found, &world, &image, &self.ba_config(10)),
                 None => return Ok(None),

@@ -1,8 +1,13 @@
 //! Tuning aid shared by the tracking examples: `SYLVA_CFG="min_parallax_deg=0.5,outlier_px=4"`
-//! overrides [`sylva_tracking::TrackerConfig`] fields.
+//! overrides [`sylva_tracking::TrackerConfig`] fields; `SYLVA_BACKEND=portable` (or `opencv`)
+//! picks the vision backend.
 
 pub fn config_from_env() -> sylva_tracking::TrackerConfig {
     let mut config = sylva_tracking::TrackerConfig::default();
+    if let Ok(name) = std::env::var("SYLVA_BACKEND") {
+        config.backend = sylva_tracking::VisionBackend::from_name(&name)
+            .unwrap_or_else(|| panic!("SYLVA_BACKEND: opencv or portable, not {name}"));
+    }
     for pair in std::env::var("SYLVA_CFG")
         .unwrap_or_default()
         .split(',')
