@@ -25,6 +25,8 @@ pub struct FoliageFit {
     pub leaf_scale: f32,
     /// Leaves per metre, times the species'.
     pub density_scale: f32,
+    /// Shoots end at least this many hull voxels inside the crown's surface.
+    pub trim_voxels: usize,
     /// Mean IoU of the foliage with the targets, the species' own foliage and the fitted.
     pub iou_before: f64,
     pub iou_after: f64,
@@ -77,37 +79,22 @@ fn with_foliage(tree: &Tree, length: f32, width: f32, per_metre: f32) -> Tree {
     out
 }
 
-/// Chooses the leaf size, then the density, that agree best with `targets`, and sets them in
-/// `tree`'s looks. Without targets the tree is left as it is.
-pub fn fit_foliage(
-    tree: &mut Tree,
-    world_from_tree: &Affine3A,
-    footage: &TrackedFootage,
-    targets: &[&CrownTarget],
-) -> FoliageFit {
+/// Chooses the leaf size, then the density, that `score` (the foliage's agreement with the
+/// crown's views, [`foliage_iou`]) rates best, and returns the tree with them in its looks.
+pub fn fit_foliage(tree: &Tree, score: &dyn Fn(&Tree) -> f64) -> (Tree, FoliageFit) {
     let looks = tree.species.looks().clone();
-    let grown: &Tree = &*tree;
-    let score = |leaf: f32, density: f32| {
-        let candidate = with_foliage(
-            grown,
+    let scaled = |leaf: f32, density: f32| {
+        with_foliage(
+            tree,
             looks.leaf_length * leaf,
             looks.leaf_width * leaf,
             looks.leaves_per_metre * density,
-        );
-        foliage_iou(&candidate, world_from_tree, footage, targets)
+        )
     };
-    if targets.is_empty() {
-        return FoliageFit {
-            leaf_scale: 1.0,
-            density_scale: 1.0,
-            iou_before: 0.0,
-            iou_after: 0.0,
-        };
-    }
-    let before = score(1.0, 1.0);
+    let before = score(tree);
     let (mut leaf, mut best) = (1.0, before);
     for &s in &LEAF_SCALES[1..] {
-        let iou = score(s, 1.0);
+        let iou = score(&scaled(s, 1.0));
         if iou > best {
             (leaf, best) = (s, iou);
         } else {
@@ -117,24 +104,19 @@ pub fn fit_foliage(
     }
     let mut density = 1.0;
     for &d in &DENSITY_SCALES[1..] {
-        let iou = score(leaf, d);
+        let iou = score(&scaled(leaf, d));
         if iou > best {
             (density, best) = (d, iou);
         } else {
             break;
         }
     }
-    let fitted = with_foliage(
-        grown,
-        looks.leaf_length * leaf,
-        looks.leaf_width * leaf,
-        looks.leaves_per_metre * density,
-    );
-    *tree = fitted;
-    FoliageFit {
+    let fit = FoliageFit {
         leaf_scale: leaf,
         density_scale: density,
+        trim_voxels: 0,
         iou_before: before,
         iou_after: best,
-    }
+    };
+    (scaled(leaf, density), fit)
 }

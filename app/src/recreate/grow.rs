@@ -11,6 +11,7 @@ use sylva_core::environment::{Scene, SceneMode};
 use sylva_core::growth::StepOptions;
 use sylva_core::species::Species;
 
+use super::fit::{FoliageFit, fit_foliage};
 use super::hull::Hull;
 use super::measure::Recreation;
 
@@ -72,6 +73,8 @@ const MIN_GAIN: f32 = 0.005;
 const GAIN_WINDOW: usize = 5;
 /// With a coverage score, growth stops after this many iterations without a better one.
 const COVER_WINDOW: usize = 4;
+/// Shoots are trimmed to end at most this many voxels inside the crown's surface.
+const TRIM_VOXELS: usize = 3;
 
 /// Scores a grown tree (its widths updated, the trunk bare) against the crown's views.
 pub type Coverage<'a> = &'a (dyn Fn(&Tree) -> f64 + Sync);
@@ -416,9 +419,45 @@ pub fn grow_into_hull(
     if let Some((_, best_filled, best_tree)) = best {
         (filled, tree) = (best_filled, best_tree);
     }
-    trim_outside(&mut tree, in_crown);
-    tree.update_widths();
-    bare_trunk(&mut tree, crown_base_m, leafy_diameters);
+    let finish = |tree: &Tree, inside: &dyn Fn(Vec3) -> bool| {
+        let mut finished = tree.clone();
+        trim_outside(&mut finished, inside);
+        finished.update_widths();
+        bare_trunk(&mut finished, crown_base_m, leafy_diameters);
+        finished
+    };
+    // What sticks out of the crown goes. How far inside the crown's surface its shoots must end
+    // (0 to TRIM_VOXELS: their leaves reach on past them) and the leaves' size and density are
+    // chosen together by the views' coverage.
+    let mut foliage = None;
+    tree = match (crown, coverage) {
+        (Some(crown), Some(coverage)) => {
+            let mut fitted: Option<(Tree, FoliageFit)> = None;
+            for k in 0..=TRIM_VOXELS {
+                let shrunk = crown.eroded(k as f64 * crown.voxel_m);
+                let inside =
+                    |p: Vec3| shrunk.contains(world_from_tree.transform_point3(p).as_dvec3(), 0);
+                let (candidate, mut fit) = fit_foliage(&finish(&tree, &inside), coverage);
+                fit.trim_voxels = k;
+                if fitted.as_ref().is_none_or(|(_, b)| fit.iou_after > b.iou_after) {
+                    fitted = Some((candidate, fit));
+                }
+            }
+            match fitted {
+                Some((fitted, fit)) => {
+                    foliage = Some(fit);
+                    fitted
+                }
+                None => finish(&tree, &in_crown),
+            }
+        }
+        (None, Some(coverage)) => {
+            let (fitted, fit) = fit_foliage(&finish(&tree, &in_crown), coverage);
+            foliage = Some(fit);
+            fitted
+        }
+        _ => finish(&tree, &in_crown),
+    };
     let report = GrowthReport {
         species: tree.species.name.clone(),
         species_choice,
@@ -428,7 +467,7 @@ pub fn grow_into_hull(
         attraction_points: num_points,
         segmented_views: 0,
         crown_voxels: None,
-        foliage: None,
+        foliage,
     };
     (tree, world_from_tree, report)
 }

@@ -17,8 +17,8 @@ pub mod silhouette;
 
 use glam::{Affine3A, Vec3};
 
-/// Views of the crown that score each year of growth (the fit of the foliage uses all).
-const GROWTH_VIEWS: usize = 8;
+/// Views of the crown that score the growth and the foliage.
+const GROWTH_VIEWS: usize = 10;
 use sylva_core::geometry::{TreeMesh, TreeMeshes};
 
 /// Moves every mesh of `meshes` (built in tree space) into the world by `world_from_tree`.
@@ -121,7 +121,7 @@ pub fn recreate(
             })
             .collect()
     };
-    // Growth is scored on a few of them (the marked ones first), the foliage fitted to all.
+    // Growth and the foliage are scored on a few of them (the marked ones first).
     let scored: Vec<&fit::CrownTarget> = fit::spread(&targets, &marked, GROWTH_VIEWS);
     let placed = grow::world_from_tree(recreation.base, footage.ground.normal);
     let score = |tree: &sylva_core::Tree| fit::foliage_iou(tree, &placed, footage, &scored);
@@ -138,14 +138,6 @@ pub fn recreate(
     );
     growth.segmented_views = crown_masks.len();
     growth.crown_voxels = crown.as_ref().map(|c| c.num_voxels());
-    let all: Vec<&fit::CrownTarget> = targets.iter().collect();
-    let mut tree = tree;
-    growth.foliage = Some(fit::fit_foliage(
-        &mut tree,
-        &world_from_tree,
-        footage,
-        &all,
-    ));
     let mut recreated = Recreated {
         recreation,
         tree,
