@@ -282,11 +282,13 @@ fn tree_b_in_front_of_a_wall_from_two_outlines_measures_height_width_and_crown_b
     check_iou("tree_b", marked, unmarked);
 }
 
-/// The targets are IoU 0.80 in the marked views and 0.70 in the others; the model (leaf
-/// cards alpha-tested, as drawn) reaches about 0.42-0.45 today, its crown sparser than the
-/// real one. Until the targets hold this guards what holds: a floor a little under today's.
-const MIN_IOU_MARKED: f64 = 0.38;
-const MIN_IOU_UNMARKED: f64 = 0.38;
+/// The targets are IoU 0.80 in the marked views and 0.70 in the others. With the crown
+/// segmented in the footage and the foliage fitted to it the model (leaf cards alpha-tested, as
+/// drawn) reaches 0.62-0.64 marked and 0.60-0.65 unmarked; its leaves fringe the real crown's
+/// lobes, its trunk is thinner than the real one. Until the targets hold this guards what holds:
+/// a floor a little under today's.
+const MIN_IOU_MARKED: f64 = 0.60;
+const MIN_IOU_UNMARKED: f64 = 0.58;
 
 fn check_iou(name: &str, marked: f64, unmarked: f64) {
     assert!(

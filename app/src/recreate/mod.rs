@@ -99,8 +99,13 @@ pub fn recreate(
             segment::segment_frames(footage, &recreation.hull, &frames, load)
         })
         .unwrap_or_default();
-    let crown = (!crown_masks.is_empty())
-        .then(|| segment::carve_by_silhouettes(footage, &recreation.hull, &crown_masks));
+    // The crown's volume: the hull carved again by the segmented silhouettes, else the hull.
+    let segmented = !crown_masks.is_empty();
+    let crown = if segmented {
+        segment::carve_by_silhouettes(footage, &recreation.hull, &crown_masks)
+    } else {
+        recreation.hull.clone()
+    };
     // The crown's views the tree should cover: its segmented silhouettes, else the outlines.
     let targets: Vec<fit::CrownTarget> = if crown_masks.is_empty() {
         let (w, h) = (footage.camera.width, footage.camera.height);
@@ -131,13 +136,13 @@ pub fn recreate(
         choice,
         seed,
         &recreation,
-        crown.as_ref(),
+        Some(&crown),
         Some(coverage),
         footage.ground.normal,
         max_years,
     );
     growth.segmented_views = crown_masks.len();
-    growth.crown_voxels = crown.as_ref().map(|c| c.num_voxels());
+    growth.crown_voxels = segmented.then(|| crown.num_voxels());
     let mut recreated = Recreated {
         recreation,
         tree,
