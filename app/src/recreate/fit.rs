@@ -60,8 +60,14 @@ pub fn foliage_iou(
 
 /// At most `n` of `targets`: those of the `first` frames, then others spread evenly.
 pub fn spread<'a>(targets: &'a [CrownTarget], first: &[usize], n: usize) -> Vec<&'a CrownTarget> {
-    let mut out: Vec<&CrownTarget> = targets.iter().filter(|t| first.contains(&t.frame)).collect();
-    let rest: Vec<&CrownTarget> = targets.iter().filter(|t| !first.contains(&t.frame)).collect();
+    let mut out: Vec<&CrownTarget> = targets
+        .iter()
+        .filter(|t| first.contains(&t.frame))
+        .collect();
+    let rest: Vec<&CrownTarget> = targets
+        .iter()
+        .filter(|t| !first.contains(&t.frame))
+        .collect();
     let room = n.saturating_sub(out.len()).min(rest.len());
     for k in 0..room {
         out.push(rest[(2 * k + 1) * rest.len() / (2 * room)]);

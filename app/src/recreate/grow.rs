@@ -3,7 +3,11 @@
 //! points fill it, and no shoot leaves it: core's grow-in-front scene mode) and the tree's own
 //! points as extra attraction points, until it fills the hull or stops gaining, never above the
 //! measured height. The trunk's narrow column below the crown is free space too, so the trunk
-//! can reach the crown, and branches it grows below the crown base are removed (crown lifting). The result is an ordinary tree in its own space; `world_from_tree` places it.
+//! can reach the crown, and branches it grows below the crown base are removed (crown lifting).
+//! With the crown's own volume (the hull carved by segmented silhouettes) the attraction points
+//! fill that instead, growth runs while a coverage score of the crown's views rises, shoots that
+//! stick out of the crown are cut, and the foliage is fitted to the views ([`super::fit`]). The
+//! result is an ordinary tree in its own space; `world_from_tree` places it.
 
 use glam::{Affine3A, DVec3, Quat, Vec3};
 use sylva_core::Tree;
@@ -439,7 +443,10 @@ pub fn grow_into_hull(
                     |p: Vec3| shrunk.contains(world_from_tree.transform_point3(p).as_dvec3(), 0);
                 let (candidate, mut fit) = fit_foliage(&finish(&tree, &inside), coverage);
                 fit.trim_voxels = k;
-                if fitted.as_ref().is_none_or(|(_, b)| fit.iou_after > b.iou_after) {
+                if fitted
+                    .as_ref()
+                    .is_none_or(|(_, b)| fit.iou_after > b.iou_after)
+                {
                     fitted = Some((candidate, fit));
                 }
             }

@@ -202,8 +202,8 @@ pub fn segment(frame: usize, image: &image::RgbImage, projection: &[bool]) -> Op
     let mut inside = vec![false; width * height];
     for round in 0..ROUNDS {
         for (i, v) in inside.iter_mut().enumerate() {
-            *v = outside[i] <= REGION_PX
-                && crown.density[pixels[i]] > background.density[pixels[i]];
+            *v =
+                outside[i] <= REGION_PX && crown.density[pixels[i]] > background.density[pixels[i]];
         }
         if round + 1 < ROUNDS {
             match ColourModel::of(image, |i| inside[i]) {
