@@ -83,6 +83,13 @@ const TRIM_VOXELS: usize = 3;
 /// Scores a grown tree (its widths updated, the trunk bare) against the crown's views.
 pub type Coverage<'a> = &'a (dyn Fn(&Tree) -> f64 + Sync);
 
+/// What the crown's views add to [`grow_into_hull`]: the crown's own volume and a coverage score.
+#[derive(Clone, Copy, Default)]
+pub struct Guide<'a> {
+    pub crown: Option<&'a Hull>,
+    pub coverage: Option<Coverage<'a>>,
+}
+
 /// The tree placed at the trunk base, upright on the ground.
 pub fn world_from_tree(base: DVec3, up: DVec3) -> Affine3A {
     let up = up.as_vec3().try_normalize().unwrap_or(Vec3::Y);
@@ -296,10 +303,10 @@ pub fn bare_trunk(tree: &mut Tree, crown_base_m: f32, leafy_diameters: f32) {
     tree.species.looks = Some(looks);
 }
 
-/// Grows `species` into the recreation's hull; `max_years` bounds the growth. `crown`, when
+/// Grows `species` into the recreation's hull; `max_years` bounds the growth. `guide.crown`, when
 /// given, is the crown's own volume inside the hull (the hull carved again by the segmented
 /// silhouettes, [`super::segment`]): the attraction points fill it, and the fill is measured
-/// in it, while shoots may still cross the hull's gaps between its lobes. `coverage`, when
+/// in it, while shoots may still cross the hull's gaps between its lobes. `guide.coverage`, when
 /// given, scores a grown tree against the crown's views (its foliage's agreement with them):
 /// growth then goes on while that rises and the best-scoring tree is kept.
 pub fn grow_into_hull(
@@ -307,11 +314,11 @@ pub fn grow_into_hull(
     species_choice: String,
     seed: u64,
     recreation: &Recreation,
-    crown: Option<&Hull>,
-    coverage: Option<Coverage>,
+    guide: Guide,
     up: DVec3,
     max_years: f32,
 ) -> (Tree, Affine3A, GrowthReport) {
+    let Guide { crown, coverage } = guide;
     let world_from_tree = world_from_tree(recreation.base, up);
     let tree_from_world = world_from_tree.inverse();
     let m = &recreation.measurements;

@@ -136,8 +136,10 @@ pub fn recreate(
         choice,
         seed,
         &recreation,
-        Some(&crown),
-        Some(coverage),
+        grow::Guide {
+            crown: Some(&crown),
+            coverage: Some(coverage),
+        },
         footage.ground.normal,
         max_years,
     );
