@@ -104,7 +104,8 @@ impl ColourModel {
     }
 }
 
-/// Euclidean-like (chamfer 1, √2) distance from every pixel to the nearest `true` one.
+/// Chamfer (1, √2) distance from every pixel to the nearest `true` one: exact along the axes
+/// and diagonals, at most 8.3% over the Euclidean between them.
 fn distance_to(mask: &[bool], width: usize, height: usize) -> Vec<f32> {
     let mut d: Vec<f32> = mask
         .iter()
@@ -370,7 +371,9 @@ mod tests {
         assert!((d[25 * w + 35] - 10.0).abs() < 1e-4);
         let diagonal = d[35 * w + 35];
         assert!((diagonal - 200f32.sqrt()).abs() < 0.1, "{diagonal}");
+        // Off the axes and diagonals the (1, √2) chamfer overestimates, by 8.3% at most.
         let knight = d[45 * w + 35];
-        assert!((knight - 500f32.sqrt()).abs() < 1.0, "{knight}");
+        let euclid = 500f32.sqrt();
+        assert!(knight >= euclid && knight <= 1.083 * euclid, "{knight}");
     }
 }
