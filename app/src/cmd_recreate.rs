@@ -123,8 +123,22 @@ pub fn recreate(args: RecreateArgs) -> anyhow::Result<()> {
     drop(sequence);
     let footage = track_footage(&args.footage, args.holding_height_m)
         .with_context(|| format!("tracking {}", args.footage.display()))?;
-    let recreated = crate::recreate::recreate(&footage, &marks, species, args.seed, args.max_years)
-        .with_context(|| format!("bad marks in {}", args.marks.display()))?;
+    // The frames' images, for segmenting the crown (a frame that does not load is left out).
+    let images = crate::footage::Footage::open(&args.footage)?;
+    let load = |frame: usize| {
+        let rgba = images.load_rgba(frame).ok()?;
+        Some(image::DynamicImage::ImageRgba8(rgba).into_rgb8())
+    };
+    let load: crate::recreate::segment::FrameSource = &load;
+    let recreated = crate::recreate::recreate(
+        &footage,
+        &marks,
+        species,
+        args.seed,
+        args.max_years,
+        Some(load),
+    )
+    .with_context(|| format!("bad marks in {}", args.marks.display()))?;
     let (tree, world_from_tree) = (&recreated.tree, recreated.world_from_tree);
     let (m, growth) = (&recreated.recreation.measurements, &recreated.growth);
     tree.save(&args.out)?;
@@ -198,6 +212,18 @@ pub fn recreate(args: RecreateArgs) -> anyhow::Result<()> {
         growth.age_years,
         growth.hull_filled * 100.0
     );
+    if let Some(voxels) = growth.crown_voxels {
+        println!(
+            "crown: segmented in {} views, {voxels} of the hull's {} voxels kept",
+            growth.segmented_views, m.hull_voxels
+        );
+    }
+    if let Some(f) = &growth.foliage {
+        println!(
+            "foliage: leaves x{:.2}, density x{:.2} (IoU with the crown {:.3} -> {:.3})",
+            f.leaf_scale, f.density_scale, f.iou_before, f.iou_after
+        );
+    }
     println!(
         "height_m={:.3} crown_width_m={:.3} crown_base_m={:.3} tree_points={} internodes={} outline_iou={:.3}",
         m.height_m, m.crown_width_m, m.crown_base_m, m.tree_points, internodes, iou_mean

@@ -193,8 +193,8 @@ fn tree_a_from_three_outlines_measures_height_width_and_crown_base_and_regrows_a
 }
 
 /// The recreated tree is an ordinary tree: cut its largest main limb, grow 10 years, and the crown
-/// regrows into the gap (more internodes there than right after the cut), though less than the
-/// tree grown 10 years without the cut.
+/// regrows into the gap (new internodes there, at least a quarter of the limb's count), though
+/// less than the tree grown 10 years without the cut.
 fn prune_a_main_limb_and_grow_ten_years(tree_file: &Path) {
     use sylva_core::Tree;
     let tree = Tree::load(tree_file).expect("the recreated tree loads");
@@ -237,13 +237,29 @@ fn prune_a_main_limb_and_grow_ten_years(tree_file: &Path) {
     let mut unpruned = tree.clone();
     unpruned.grow_years(10.0);
     let (regrown_n, unpruned_n) = (in_gap(&regrown), in_gap(&unpruned));
+    // What grew into the gap after the cut: internodes of the regrown tree there that the cut
+    // tree did not have (a full crown also sheds shaded shoots around the gap meanwhile, so the
+    // count there can fall even as the gap fills).
+    let new_in_gap = regrown
+        .skeleton
+        .internodes
+        .iter()
+        .filter(|n| gap.iter().any(|g| g.distance(n.end) < 0.25))
+        .filter(|n| {
+            !cut.skeleton
+                .internodes
+                .iter()
+                .any(|c| c.end.distance(n.end) < 1e-3)
+        })
+        .count();
     println!(
-        "prune: limb of {} internodes; in the gap: {after_cut} after the cut, {regrown_n} after 10 years, {unpruned_n} unpruned",
+        "prune: limb of {} internodes; in the gap: {after_cut} after the cut, {regrown_n} after 10 years ({new_in_gap} grown there since the cut), {unpruned_n} unpruned",
         gap.len()
     );
     assert!(
-        regrown_n > after_cut,
-        "no regrowth into the gap: {regrown_n} internodes after 10 years, {after_cut} after the cut"
+        new_in_gap * 4 >= gap.len(),
+        "no regrowth into the gap: {new_in_gap} internodes grew there in 10 years after cutting a limb of {}",
+        gap.len()
     );
     assert!(
         regrown_n < unpruned_n,
@@ -266,11 +282,13 @@ fn tree_b_in_front_of_a_wall_from_two_outlines_measures_height_width_and_crown_b
     check_iou("tree_b", marked, unmarked);
 }
 
-/// The targets are IoU 0.80 in the marked views and 0.70 in the others; the model (leaf
-/// cards alpha-tested, as drawn) reaches about 0.42-0.45 today, its crown sparser than the
-/// real one. Until the targets hold this guards what holds: a floor a little under today's.
-const MIN_IOU_MARKED: f64 = 0.38;
-const MIN_IOU_UNMARKED: f64 = 0.38;
+/// The targets are IoU 0.80 in the marked views and 0.70 in the others. With the crown
+/// segmented in the footage and the foliage fitted to it the model (leaf cards alpha-tested, as
+/// drawn) reaches 0.62-0.64 marked and 0.60-0.65 unmarked; its leaves fringe the real crown's
+/// lobes, its trunk is thinner than the real one. Until the targets hold this guards what holds:
+/// a floor a little under today's.
+const MIN_IOU_MARKED: f64 = 0.60;
+const MIN_IOU_UNMARKED: f64 = 0.58;
 
 fn check_iou(name: &str, marked: f64, unmarked: f64) {
     assert!(

@@ -3,7 +3,11 @@
 //! points fill it, and no shoot leaves it: core's grow-in-front scene mode) and the tree's own
 //! points as extra attraction points, until it fills the hull or stops gaining, never above the
 //! measured height. The trunk's narrow column below the crown is free space too, so the trunk
-//! can reach the crown, and branches it grows below the crown base are removed (crown lifting). The result is an ordinary tree in its own space; `world_from_tree` places it.
+//! can reach the crown, and branches it grows below the crown base are removed (crown lifting).
+//! With the crown's own volume (the hull carved by segmented silhouettes) the attraction points
+//! fill that instead, growth runs while a coverage score of the crown's views rises, shoots that
+//! stick out of the crown are cut, and the foliage is fitted to the views ([`super::fit`]). The
+//! result is an ordinary tree in its own space; `world_from_tree` places it.
 
 use glam::{Affine3A, DVec3, Quat, Vec3};
 use sylva_core::Tree;
@@ -11,6 +15,7 @@ use sylva_core::environment::{Scene, SceneMode};
 use sylva_core::growth::StepOptions;
 use sylva_core::species::Species;
 
+use super::fit::{FoliageFit, fit_foliage};
 use super::hull::Hull;
 use super::measure::Recreation;
 
@@ -50,6 +55,12 @@ pub struct GrowthReport {
     /// Fraction of the hull's coarse cells reached by the tree.
     pub hull_filled: f32,
     pub attraction_points: usize,
+    /// Frames the crown was segmented in (0 without the footage's images).
+    pub segmented_views: usize,
+    /// Voxels of the hull carved again by those silhouettes (None without them).
+    pub crown_voxels: Option<usize>,
+    /// The foliage fitted to the crown's silhouettes ([`super::fit`]).
+    pub foliage: Option<super::fit::FoliageFit>,
 }
 
 /// Leaf cards reach about this far beyond the twigs that carry them (m): the envelope growth
@@ -64,6 +75,20 @@ const FILLED: f32 = 0.9;
 /// ... or it gained less than this over the last few iterations.
 const MIN_GAIN: f32 = 0.005;
 const GAIN_WINDOW: usize = 5;
+/// With a coverage score, growth stops after this many iterations without a better one.
+const COVER_WINDOW: usize = 4;
+/// Shoots are trimmed to end at most this many voxels inside the crown's surface.
+const TRIM_VOXELS: usize = 3;
+
+/// Scores a grown tree (its widths updated, the trunk bare) against the crown's views.
+pub type Coverage<'a> = &'a (dyn Fn(&Tree) -> f64 + Sync);
+
+/// What the crown's views add to [`grow_into_hull`]: the crown's own volume and a coverage score.
+#[derive(Clone, Copy, Default)]
+pub struct Guide<'a> {
+    pub crown: Option<&'a Hull>,
+    pub coverage: Option<Coverage<'a>>,
+}
 
 /// The tree placed at the trunk base, upright on the ground.
 pub fn world_from_tree(base: DVec3, up: DVec3) -> Affine3A {
@@ -228,6 +253,34 @@ pub fn lift_crown(tree: &mut Tree, crown_base_m: f32, leaf_reach_m: f32) -> usiz
     }
 }
 
+/// Prunes what sticks out of the crown: every shoot that ends outside `inside` (tree space) and
+/// carries nothing that ends inside goes, with what it carries; branches crossing a gap between
+/// the crown's lobes stay (what they carry is inside). Returns how many internodes went.
+pub fn trim_outside(tree: &mut Tree, inside: impl Fn(Vec3) -> bool) -> usize {
+    let nodes = &tree.skeleton.internodes;
+    let mut keep: Vec<bool> = nodes.iter().map(|n| inside(n.end)).collect();
+    // Parents come first in the arena: one backward pass carries "something inside" up.
+    for i in (0..nodes.len()).rev() {
+        if keep[i]
+            && let Some(parent) = nodes[i].parent
+        {
+            keep[parent.index()] = true;
+        }
+    }
+    if !keep.first().copied().unwrap_or(false) {
+        return 0;
+    }
+    let roots: Vec<sylva_core::NodeId> = (0..nodes.len())
+        .filter(|&i| !keep[i] && nodes[i].parent.is_none_or(|p| keep[p.index()]))
+        .map(|i| sylva_core::NodeId(i as u32))
+        .collect();
+    if roots.is_empty() {
+        0
+    } else {
+        tree.remove_subtrees(&roots)
+    }
+}
+
 /// The trunk below the crown base is bare, as measured: leaves grow only on branches thinner
 /// than the trunk where it meets the crown base (the tree's leafy threshold, in tip diameters,
 /// lowered to that from the species' `leafy_diameters` when the trunk is thinner than it).
@@ -250,15 +303,22 @@ pub fn bare_trunk(tree: &mut Tree, crown_base_m: f32, leafy_diameters: f32) {
     tree.species.looks = Some(looks);
 }
 
-/// Grows `species` into the recreation's hull; `max_years` bounds the growth.
+/// Grows `species` into the recreation's hull; `max_years` bounds the growth. `guide.crown`, when
+/// given, is the crown's own volume inside the hull (the hull carved again by the segmented
+/// silhouettes, [`super::segment`]): the attraction points fill it, and the fill is measured
+/// in it, while shoots may still cross the hull's gaps between its lobes. `guide.coverage`, when
+/// given, scores a grown tree against the crown's views (its foliage's agreement with them):
+/// growth then goes on while that rises and the best-scoring tree is kept.
 pub fn grow_into_hull(
     species: Species,
     species_choice: String,
     seed: u64,
     recreation: &Recreation,
+    guide: Guide,
     up: DVec3,
     max_years: f32,
 ) -> (Tree, Affine3A, GrowthReport) {
+    let Guide { crown, coverage } = guide;
     let world_from_tree = world_from_tree(recreation.base, up);
     let tree_from_world = world_from_tree.inverse();
     let m = &recreation.measurements;
@@ -280,7 +340,19 @@ pub fn grow_into_hull(
         ..scene
     };
     let crown_base_m = m.crown_base_m as f32;
-    let hull_in_tree: Vec<Vec3> = envelope
+    // The volume the attraction points fill: the crown's own (shrunk by half the leaves' reach,
+    // its lobes are small), else the envelope.
+    let target = crown.map(|c| {
+        let shrunk = c.eroded(0.5 * LEAF_REACH_M);
+        if shrunk.num_voxels() * 4 >= c.num_voxels() {
+            shrunk
+        } else {
+            c.clone()
+        }
+    });
+    let hull_in_tree: Vec<Vec3> = target
+        .as_ref()
+        .unwrap_or(&envelope)
         .voxels()
         .into_iter()
         .map(|p| tree_from_world.transform_point3(p.as_vec3()))
@@ -311,8 +383,14 @@ pub fn grow_into_hull(
     let leafy_diameters = tree.species.looks().leafy_diameters;
     let mut history: Vec<f32> = Vec::new();
     let mut filled = 0.0;
-    // Shedding may take back what a few iterations filled: the fullest tree is kept.
-    let mut best: Option<(f32, Tree)> = None;
+    // Shedding may take back what a few iterations filled: the fullest tree is kept (by the
+    // coverage of the crown's views when given, else by the hull's fill).
+    let mut best: Option<(f64, f32, Tree)> = None;
+    let mut since_best = 0;
+    // The crown's own volume, in tree space (everything without it).
+    let in_crown = |p: Vec3| {
+        crown.is_none_or(|c| c.contains(world_from_tree.transform_point3(p).as_dvec3(), 0))
+    };
     for _ in 0..max_iterations {
         tree.step(StepOptions {
             autonomous: true,
@@ -321,22 +399,79 @@ pub fn grow_into_hull(
         lift_crown(&mut tree, crown_base_m, LEAF_REACH_M as f32);
         filled = grid.filled(&tree, reach_m);
         history.push(filled);
-        if best.as_ref().is_none_or(|(f, _)| filled > *f) {
-            best = Some((filled, tree.clone()));
+        let score = match coverage {
+            Some(coverage) => {
+                let mut finished = tree.clone();
+                trim_outside(&mut finished, in_crown);
+                finished.update_widths();
+                bare_trunk(&mut finished, crown_base_m, leafy_diameters);
+                coverage(&finished)
+            }
+            None => f64::from(filled),
+        };
+        since_best += 1;
+        if best.as_ref().is_none_or(|(b, _, _)| score > *b) {
+            best = Some((score, filled, tree.clone()));
+            since_best = 0;
         }
-        // Early on the seedling is still climbing the trunk's column: no stall before half.
-        let stalled = filled > 0.5
-            && history.len() > GAIN_WINDOW
-            && filled - history[history.len() - 1 - GAIN_WINDOW] < MIN_GAIN;
-        if filled >= FILLED || stalled {
+        let stalled = if coverage.is_some() {
+            // The views' coverage has not risen for a while: the crown is as full as it gets.
+            since_best >= COVER_WINDOW
+        } else {
+            // Early on the seedling is still climbing the trunk's column: no stall before half.
+            filled > 0.5
+                && history.len() > GAIN_WINDOW
+                && filled - history[history.len() - 1 - GAIN_WINDOW] < MIN_GAIN
+        };
+        if (coverage.is_none() && filled >= FILLED) || stalled {
             break;
         }
     }
-    if let Some((best_filled, best_tree)) = best {
+    if let Some((_, best_filled, best_tree)) = best {
         (filled, tree) = (best_filled, best_tree);
     }
-    tree.update_widths();
-    bare_trunk(&mut tree, crown_base_m, leafy_diameters);
+    let finish = |tree: &Tree, inside: &dyn Fn(Vec3) -> bool| {
+        let mut finished = tree.clone();
+        trim_outside(&mut finished, inside);
+        finished.update_widths();
+        bare_trunk(&mut finished, crown_base_m, leafy_diameters);
+        finished
+    };
+    // What sticks out of the crown goes. How far inside the crown's surface its shoots must end
+    // (0 to TRIM_VOXELS: their leaves reach on past them) and the leaves' size and density are
+    // chosen together by the views' coverage.
+    let mut foliage = None;
+    tree = match (crown, coverage) {
+        (Some(crown), Some(coverage)) => {
+            let mut fitted: Option<(Tree, FoliageFit)> = None;
+            for k in 0..=TRIM_VOXELS {
+                let shrunk = crown.eroded(k as f64 * crown.voxel_m);
+                let inside =
+                    |p: Vec3| shrunk.contains(world_from_tree.transform_point3(p).as_dvec3(), 0);
+                let (candidate, mut fit) = fit_foliage(&finish(&tree, &inside), coverage);
+                fit.trim_voxels = k;
+                if fitted
+                    .as_ref()
+                    .is_none_or(|(_, b)| fit.iou_after > b.iou_after)
+                {
+                    fitted = Some((candidate, fit));
+                }
+            }
+            match fitted {
+                Some((fitted, fit)) => {
+                    foliage = Some(fit);
+                    fitted
+                }
+                None => finish(&tree, &in_crown),
+            }
+        }
+        (None, Some(coverage)) => {
+            let (fitted, fit) = fit_foliage(&finish(&tree, &in_crown), coverage);
+            foliage = Some(fit);
+            fitted
+        }
+        _ => finish(&tree, &in_crown),
+    };
     let report = GrowthReport {
         species: tree.species.name.clone(),
         species_choice,
@@ -344,6 +479,9 @@ pub fn grow_into_hull(
         age_years: tree.age_years(),
         hull_filled: filled,
         attraction_points: num_points,
+        segmented_views: 0,
+        crown_voxels: None,
+        foliage,
     };
     (tree, world_from_tree, report)
 }

@@ -5,15 +5,20 @@
 //! from the trunk base into the hull. The result is an ordinary tree: every edit, the years and
 //! the exports work on it. World: metres, Y up, origin on the ground plane (the tracker's).
 
+pub mod fit;
 pub mod footage;
 pub mod grow;
 pub mod hull;
 pub mod marks;
 pub mod measure;
 pub mod overlay;
+pub mod segment;
 pub mod silhouette;
 
 use glam::{Affine3A, Vec3};
+
+/// Views of the crown that score the growth and the foliage.
+const GROWTH_VIEWS: usize = 10;
 use sylva_core::geometry::{TreeMesh, TreeMeshes};
 
 /// Moves every mesh of `meshes` (built in tree space) into the world by `world_from_tree`.
@@ -68,15 +73,18 @@ impl Recreated {
 
 /// Measures the tree the marks show in the tracked footage, chooses the species (`species`, or
 /// the preset closest to the measured proportions), grows it into the hull (at most
-/// `max_years`) and scores its silhouette against each outline. The `sylva recreate` command and
-/// the app's Recreate mode both come here. The marks must already be checked against the
-/// footage's size ([`marks::Marks::validate`]).
+/// `max_years`) and scores its silhouette against each outline. With the footage's images
+/// (`images`) the crown is also segmented in its frames and the hull carved again by those
+/// silhouettes ([`segment`]): growth fills the real crown's lobes, not the outlines' convex
+/// hull. The `sylva recreate` command and the app's Recreate mode both come here. The marks
+/// must already be checked against the footage's size ([`marks::Marks::validate`]).
 pub fn recreate(
     footage: &footage::TrackedFootage,
     marks: &marks::Marks,
     species: Option<sylva_core::species::Species>,
     seed: u64,
     max_years: f32,
+    images: Option<segment::FrameSource>,
 ) -> Result<Recreated, marks::MarksError> {
     let recreation = measure::measure(footage, marks)?;
     let m = &recreation.measurements;
@@ -84,14 +92,59 @@ pub fn recreate(
         Some(s) => (s, "given".to_owned()),
         None => grow::closest_species(m.height_m, m.crown_width_m),
     };
-    let (tree, world_from_tree, growth) = grow::grow_into_hull(
+    let marked: Vec<usize> = recreation.masks.iter().map(|mask| mask.frame).collect();
+    let crown_masks = images
+        .map(|load| {
+            let frames = segment::carve_frames(footage, &marked);
+            segment::segment_frames(footage, &recreation.hull, &frames, load)
+        })
+        .unwrap_or_default();
+    // The crown's volume: the hull carved again by the segmented silhouettes, else the hull.
+    let segmented = !crown_masks.is_empty();
+    let crown = if segmented {
+        segment::carve_by_silhouettes(footage, &recreation.hull, &crown_masks)
+    } else {
+        recreation.hull.clone()
+    };
+    // The crown's views the tree should cover: its segmented silhouettes, else the outlines.
+    let targets: Vec<fit::CrownTarget> = if crown_masks.is_empty() {
+        let (w, h) = (footage.camera.width, footage.camera.height);
+        (recreation.masks.iter())
+            .map(|mask| fit::CrownTarget {
+                frame: mask.frame,
+                inside: (0..h)
+                    .flat_map(|y| (0..w).map(move |x| (x, y)))
+                    .map(|(x, y)| mask.contains(glam::DVec2::new(x as f64, y as f64)))
+                    .collect(),
+            })
+            .collect()
+    } else {
+        (crown_masks.iter())
+            .map(|mask| fit::CrownTarget {
+                frame: mask.frame,
+                inside: mask.inside.clone(),
+            })
+            .collect()
+    };
+    // Growth and the foliage are scored on a few of them (the marked ones first).
+    let scored: Vec<&fit::CrownTarget> = fit::spread(&targets, &marked, GROWTH_VIEWS);
+    let placed = grow::world_from_tree(recreation.base, footage.ground.normal);
+    let score = |tree: &sylva_core::Tree| fit::foliage_iou(tree, &placed, footage, &scored);
+    let coverage: grow::Coverage = &score;
+    let (tree, world_from_tree, mut growth) = grow::grow_into_hull(
         species,
         choice,
         seed,
         &recreation,
+        grow::Guide {
+            crown: Some(&crown),
+            coverage: Some(coverage),
+        },
         footage.ground.normal,
         max_years,
     );
+    growth.segmented_views = crown_masks.len();
+    growth.crown_voxels = segmented.then(|| crown.num_voxels());
     let mut recreated = Recreated {
         recreation,
         tree,

@@ -60,6 +60,13 @@ impl WorldTriangles {
         }
         out
     }
+
+    /// The leaf cards alone (the branches' triangles dropped).
+    pub fn leaves_only(mut self) -> Self {
+        self.indices.drain(..self.first_leaf_index);
+        self.first_leaf_index = 0;
+        self
+    }
 }
 
 /// A binary image, row-major.
