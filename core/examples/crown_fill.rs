@@ -1,7 +1,8 @@
 //! How full a preset's crown is, for trying species values: on each seed (11, 2014 and 7, or
 //! `SYLVA_SEEDS`) at each age (15 and 30 years, or `SYLVA_AGES`), the height, spread, lean, trunk
 //! diameter at breast height, internodes, leaf area index and the side view's porosity (sky in
-//! the crown's convex hull, also split into the middle 60% of each row and the rim), as
+//! the crown's convex hull, also split into the middle 60% of each row and the rim), LOD0's
+//! triangles and the `.glb`'s size, as
 //! `foliage_report` and `core/tests/foliage_density.rs` measure them; then the worst porosity
 //! and the range of the leaf area index over all crowns. Seeds grow on threads of their own.
 //! With `SYLVA_PICTURES=dir` each side view is written there as a PNG: leaves green, wood
@@ -15,6 +16,7 @@ mod overrides;
 mod seeds;
 
 use sylva_core::Tree;
+use sylva_core::export::glb_bytes;
 use sylva_core::geometry::build_tree_meshes;
 use sylva_core::geometry::crown::{
     AlphaMask, CARD_TEXTURE_SIZE, Coverage, LEAF, MEASURE_PIXEL_M, View, WOOD, crown_measures,
@@ -77,7 +79,7 @@ fn crowns_of_seed(species: &Species, seed: u64, ages: &[f32]) -> Vec<Crown> {
         }
         let line = format!(
             "seed {seed:5} {age_years:>2}y: h {:5.2} w {:5.2} lean {:4.2} dbh {dbh_cm:5.1} cm n {:6} LAI {:4.2} \
-             porosity {:4.1}% (middle {:4.1}%, rim {:4.1}%)",
+             porosity {:4.1}% (middle {:4.1}%, rim {:4.1}%) LOD0 {}k tris, glb {:.1} MB",
             m.height_m,
             m.crown_width_m,
             m.lean,
@@ -86,6 +88,8 @@ fn crowns_of_seed(species: &Species, seed: u64, ages: &[f32]) -> Vec<Crown> {
             100.0 * c.side_porosity,
             100.0 * middle,
             100.0 * rim,
+            meshes.num_triangles(0) / 1000,
+            glb_bytes(&meshes).map_or(f64::NAN, |b| b.len() as f64 * 1e-6),
         );
         out.push(Crown {
             seed,
