@@ -281,6 +281,10 @@ pub struct ReplayReport {
     pub world_from_tree: Option<[f32; 12]>,
     /// SHA-256 of each frame's RGBA pixels (empty when frames are not rendered).
     pub frame_sha256: Vec<String>,
+    /// Each frame's [`frame_thumbnail`]: what a check across machines compares (software
+    /// rasterisers on different CPUs differ in a few edge pixels, so the exact checksums match
+    /// only on the machine that recorded them).
+    pub frame_thumbnails: Vec<Vec<u8>>,
     pub num_frames: usize,
     pub ms_per_frame: f64,
     /// SHA-256 of the garden's file when the design holds several trees (None for one).
@@ -362,6 +366,7 @@ pub fn replay(
     let mut state = session.initial_design();
     let mut meshed_revision = None;
     let mut frame_sha256 = Vec::new();
+    let mut frame_thumbnails = Vec::new();
     let mut events = session.events.iter().peekable();
     let started = Instant::now();
     let mut previous_time = session.frames.first().map_or(0.0, |f| f.time_s);
@@ -394,7 +399,7 @@ pub fn replay(
                 session.frame_size[1],
                 image::imageops::FilterType::Triangle,
             );
-            write_frame(&image, step, out, &mut frame_sha256)?;
+            write_frame(&image, step, out, &mut frame_sha256, &mut frame_thumbnails)?;
             continue;
         };
         if meshed_revision != Some(state.revision) {
@@ -424,7 +429,7 @@ pub fn replay(
             .map(|g| ground_in_tree(&g, &tree_from_world));
         let camera = camera_in_tree(&camera, &tree_from_world);
         let image = target.render(gpu, renderer, &FrameView::augmented(camera, ground))?;
-        write_frame(&image, step, out, &mut frame_sha256)?;
+        write_frame(&image, step, out, &mut frame_sha256, &mut frame_thumbnails)?;
     }
     let num_frames = session.frames.len();
     let ms_per_frame = started.elapsed().as_secs_f64() * 1000.0 / num_frames.max(1) as f64;
@@ -435,6 +440,7 @@ pub fn replay(
         tree_sha256: state.tree_sha256(),
         world_from_tree: state.world_from_tree.map(|m| m.to_cols_array()),
         frame_sha256,
+        frame_thumbnails,
         num_frames,
         ms_per_frame,
         garden_sha256: state.garden_sha256(),
@@ -447,14 +453,46 @@ fn write_frame(
     step: usize,
     out: Option<&Path>,
     frame_sha256: &mut Vec<String>,
+    frame_thumbnails: &mut Vec<Vec<u8>>,
 ) -> anyhow::Result<()> {
     use sha2::Digest;
     frame_sha256.push(format!("{:x}", sha2::Sha256::digest(image.as_raw())));
+    frame_thumbnails.push(frame_thumbnail(image));
     if let Some(out) = out {
         let path = out.join(format!("frame_{step:04}.png"));
         crate::outputs::write_png(image, &path)?;
     }
     Ok(())
+}
+
+/// Cells across and down of a [`frame_thumbnail`].
+pub const THUMBNAIL_CELLS: (u32, u32) = (12, 9);
+
+/// A frame's mean colour in each of [`THUMBNAIL_CELLS`] equal cells, row by row, RGB (bytes,
+/// rounded): a summary that a moved, missing, hidden or recoloured tree changes by far more
+/// than a rasteriser's edge pixels do.
+pub fn frame_thumbnail(image: &image::RgbaImage) -> Vec<u8> {
+    let (cols, rows) = THUMBNAIL_CELLS;
+    let (width, height) = image.dimensions();
+    let mut thumbnail = Vec::with_capacity((cols * rows * 3) as usize);
+    for row in 0..rows {
+        let (y0, y1) = (row * height / rows, (row + 1) * height / rows);
+        for col in 0..cols {
+            let (x0, x1) = (col * width / cols, (col + 1) * width / cols);
+            let mut sum = [0u64; 3];
+            for y in y0..y1 {
+                for x in x0..x1 {
+                    let p = image.get_pixel(x, y).0;
+                    for (s, &c) in sum.iter_mut().zip(&p[..3]) {
+                        *s += u64::from(c);
+                    }
+                }
+            }
+            let count = (u64::from(x1 - x0) * u64::from(y1 - y0)).max(1);
+            thumbnail.extend(sum.iter().map(|&s| ((s + count / 2) / count) as u8));
+        }
+    }
+    thumbnail
 }
 
 /// Time step between two shown frames: the footage's, or one 30 Hz frame when playback looped
