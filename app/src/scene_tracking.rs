@@ -309,7 +309,6 @@ fn pinhole_of(intrinsics: &Intrinsics) -> PinholeIntrinsics {
     }
 }
 
-#[cfg(not(any(target_os = "android", target_os = "ios")))]
 mod desktop {
     use super::*;
     use anyhow::Context;
@@ -338,6 +337,8 @@ mod desktop {
     impl FrameTracker {
         /// A tracker for frames of `camera` (its intrinsics for the renderer: `intrinsics`).
         pub fn new(camera: Camera, intrinsics: Intrinsics) -> anyhow::Result<FrameTracker> {
+            // OpenCV's own threads (desktop); the portable backend (phones) uses none.
+            #[cfg(not(any(target_os = "android", target_os = "ios")))]
             sylva_tracking::cv::configure_single_thread();
             Ok(FrameTracker {
                 tracker: Tracker::new(camera, TrackerConfig::default())?,
@@ -450,34 +451,7 @@ mod desktop {
     }
 }
 
-#[cfg(not(any(target_os = "android", target_os = "ios")))]
 pub use desktop::{FrameTracker, SceneTracker};
-
-/// Phone builds leave the OpenCV tracker out: their poses come from the platform's AR session.
-#[cfg(any(target_os = "android", target_os = "ios"))]
-pub struct SceneTracker {
-    frames: Vec<SceneFrame>,
-}
-
-#[cfg(any(target_os = "android", target_os = "ios"))]
-impl SceneTracker {
-    pub fn open(root: &Path, _intrinsics: Intrinsics) -> anyhow::Result<SceneTracker> {
-        anyhow::bail!(
-            "tracking recorded footage ({}) needs the OpenCV tracker, which phone builds leave out",
-            root.display()
-        )
-    }
-
-    pub fn get(&self, index: usize) -> Option<&SceneFrame> {
-        self.frames.get(index)
-    }
-
-    pub fn frame(&mut self, index: usize) -> anyhow::Result<&SceneFrame> {
-        self.frames
-            .get(index)
-            .ok_or_else(|| anyhow::anyhow!("no tracked frame {index}"))
-    }
-}
 
 #[cfg(test)]
 mod tests {

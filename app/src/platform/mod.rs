@@ -43,8 +43,7 @@ pub use shell::{ShellApp, TouchInput};
 pub use storage::StorageLocation;
 pub use stream::{PlatformFeed, PlatformStream, TrackerChoice};
 pub use surface::{DrawSurface, OffscreenSurface, WindowSurface};
-// Sylva's own tracker (desktop) builds its scenes with it too.
-#[cfg(not(any(target_os = "android", target_os = "ios")))]
+// Sylva's own tracker builds its scenes with it too.
 pub(crate) use tracking::posed_scene;
 pub use tracking::{GROUND_MAX_TILT_DEG, PlatformTracker, ground_from_points, observations_of};
 pub use yuv::{YuvPlanes, rgba_from_yuv420};

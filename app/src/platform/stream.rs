@@ -35,7 +35,6 @@ impl PlatformFeed {
 
 enum FrameTracking {
     Platform(Box<PlatformTracker>),
-    #[cfg(not(any(target_os = "android", target_os = "ios")))]
     Own(Box<crate::scene_tracking::FrameTracker>),
 }
 
@@ -116,7 +115,6 @@ impl PlatformStream {
                 };
                 tracker.track(tracking)
             }
-            #[cfg(not(any(target_os = "android", target_os = "ios")))]
             FrameTracking::Own(tracker) => {
                 let gray = image::DynamicImage::ImageRgba8(frame.rgba.clone()).to_luma8();
                 let (width, height) = gray.dimensions();
@@ -140,19 +138,11 @@ impl PlatformStream {
     }
 }
 
-#[cfg(not(any(target_os = "android", target_os = "ios")))]
 fn own_tracker(camera: Camera, describe: &str) -> anyhow::Result<FrameTracking> {
     use anyhow::Context;
     let tracker = crate::scene_tracking::FrameTracker::new(camera, intrinsics_of(&camera))
         .with_context(|| format!("cannot start Sylva's tracker on {describe}"))?;
     Ok(FrameTracking::Own(Box::new(tracker)))
-}
-
-#[cfg(any(target_os = "android", target_os = "ios"))]
-fn own_tracker(_camera: Camera, describe: &str) -> anyhow::Result<FrameTracking> {
-    bail!(
-        "{describe}: Sylva's own tracker needs OpenCV, which phone builds leave out; this phone needs ARCore or ARKit"
-    )
 }
 
 impl LiveStream for PlatformStream {
