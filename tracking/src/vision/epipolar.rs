@@ -34,6 +34,27 @@ fn normalisation(points: &[DVec2]) -> (f64, DVec2) {
 }
 
 /// The 3 × 3 matrix `[[s, 0, −s cx], [0, s, −s cy], [0, 0, 1]]` of a normalisation.
+/// Both point sets moved and scaled by [`normalisation`] (Hartley), with the matrices that
+/// did it: `t1`, `t2m` map the first and second set's points to `q1`, `q2`.
+struct Normalised {
+    t1: DMat3,
+    t2m: DMat3,
+    q1: Vec<DVec2>,
+    q2: Vec<DVec2>,
+}
+
+impl Normalised {
+    fn of(first: &[DVec2], second: &[DVec2]) -> Normalised {
+        let (n1, n2) = (normalisation(first), normalisation(second));
+        Normalised {
+            t1: normalisation_matrix(n1),
+            t2m: normalisation_matrix(n2),
+            q1: first.iter().map(|p| n1.0 * (*p - n1.1)).collect(),
+            q2: second.iter().map(|p| n2.0 * (*p - n2.1)).collect(),
+        }
+    }
+}
+
 fn normalisation_matrix((s, c): (f64, DVec2)) -> DMat3 {
     DMat3::from_cols(
         DVec3::new(s, 0.0, 0.0),
@@ -149,10 +170,7 @@ pub fn find_essential(first: &[DVec2], second: &[DVec2], threshold: f64) -> Opti
     if n < 8 || second.len() != n {
         return None;
     }
-    let (n1, n2) = (normalisation(first), normalisation(second));
-    let (t1, t2m) = (normalisation_matrix(n1), normalisation_matrix(n2));
-    let q1: Vec<DVec2> = first.iter().map(|p| n1.0 * (*p - n1.1)).collect();
-    let q2: Vec<DVec2> = second.iter().map(|p| n2.0 * (*p - n2.1)).collect();
+    let Normalised { t1, t2m, q1, q2 } = Normalised::of(first, second);
     let thr2 = threshold * threshold;
     let mut rng = SplitMix64::new(0x5EED_E55E);
     let mut sample = Vec::with_capacity(8);
@@ -321,10 +339,7 @@ pub fn find_homography(
     if n < 4 || second.len() != n {
         return None;
     }
-    let (n1, n2) = (normalisation(first), normalisation(second));
-    let (t1, t2m) = (normalisation_matrix(n1), normalisation_matrix(n2));
-    let q1: Vec<DVec2> = first.iter().map(|p| n1.0 * (*p - n1.1)).collect();
-    let q2: Vec<DVec2> = second.iter().map(|p| n2.0 * (*p - n2.1)).collect();
+    let Normalised { t1, t2m, q1, q2 } = Normalised::of(first, second);
     let thr2 = threshold * threshold;
     let count = |h: &DMat3| {
         first
