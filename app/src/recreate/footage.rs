@@ -56,6 +56,20 @@ impl TrackedFootage {
             .flatten()
     }
 
+    /// The raw pixel and depth (metres) of a world point seen from `camera_from_world`; None
+    /// behind the camera or within a millimetre of its plane.
+    pub fn pixel_and_depth(
+        &self,
+        camera_from_world: &DAffine3,
+        point: DVec3,
+    ) -> Option<(DVec2, f64)> {
+        let c = camera_from_world.transform_point3(point);
+        (c.z > 1e-3)
+            .then(|| self.camera.pixel_from_camera(c))
+            .flatten()
+            .map(|pixel| (pixel, c.z))
+    }
+
     pub fn num_tracked(&self) -> usize {
         self.world_from_camera.iter().flatten().count()
     }

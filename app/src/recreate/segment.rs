@@ -163,15 +163,11 @@ pub fn hull_projection(footage: &TrackedFootage, frame: usize, hull: &Hull) -> V
     let camera_from_world = pose.inverse();
     let focal = 0.5 * (footage.camera.fx + footage.camera.fy);
     for p in hull.voxels() {
-        let c = camera_from_world.transform_point3(p);
-        let Some(pixel) = (c.z > 1e-3)
-            .then(|| footage.camera.pixel_from_camera(c))
-            .flatten()
-        else {
+        let Some((pixel, depth)) = footage.pixel_and_depth(&camera_from_world, p) else {
             continue;
         };
         // Half the voxel's diagonal, in pixels at its depth.
-        let r = 0.87 * hull.voxel_m * focal / c.z;
+        let r = 0.87 * hull.voxel_m * focal / depth;
         let (x0, x1) = ((pixel.x - r).ceil() as i64, (pixel.x + r).floor() as i64);
         let (y0, y1) = ((pixel.y - r).ceil() as i64, (pixel.y + r).floor() as i64);
         for y in y0.max(0)..=y1.min(height - 1) {
@@ -298,11 +294,7 @@ pub fn carve_by_silhouettes(footage: &TrackedFootage, hull: &Hull, masks: &[Crow
                     let Some(camera_from_world) = pose else {
                         continue;
                     };
-                    let c = camera_from_world.transform_point3(p);
-                    let Some(pixel) = (c.z > 1e-3)
-                        .then(|| footage.camera.pixel_from_camera(c))
-                        .flatten()
-                    else {
+                    let Some((pixel, _)) = footage.pixel_and_depth(camera_from_world, p) else {
                         continue;
                     };
                     let in_image = pixel.x >= 0.0

@@ -87,10 +87,9 @@ impl Silhouette {
                 .positions
                 .iter()
                 .map(|p| {
-                    let c = camera_from_world.transform_point3(p.as_dvec3());
-                    (c.z > 1e-3)
-                        .then(|| footage.camera.pixel_from_camera(c))
-                        .flatten()
+                    footage
+                        .pixel_and_depth(&camera_from_world, p.as_dvec3())
+                        .map(|(pixel, _)| pixel)
                 })
                 .collect();
             for (t, triangle) in model.indices.chunks_exact(3).enumerate() {
