@@ -177,11 +177,16 @@ fn create_gfx(event_loop: &ActiveEventLoop, size: (u32, u32)) -> anyhow::Result<
         (size.width, size.height),
         window.scale_factor() as f32,
     )?;
-    let mut drawer = ViewDrawer::new(&gpu, surface.format());
-    // On a CPU rasteriser the AR view is drawn at the footage's resolution and stretched over
-    // the window.
+    // On a CPU rasteriser the UI is drawn by the lean painter, and the AR view at the footage's
+    // resolution stretched over the window.
+    let adapter = gpu.adapter.get_info();
+    let mut drawer = ViewDrawer::with_ui_painter(
+        &gpu,
+        surface.format(),
+        crate::render::ui_painter::interactive_ui_painter(&adapter),
+    );
     drawer.set_scene_resolution(crate::render::upscale::interactive_scene_resolution(
-        &gpu.adapter.get_info(),
+        &adapter,
     ));
     let egui_state = egui_winit::State::new(
         drawer.egui_ctx().clone(),

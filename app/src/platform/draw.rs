@@ -7,6 +7,7 @@ use std::time::Instant;
 use super::DisplayTransform;
 use crate::player::Player;
 use crate::render::resources::letterbox;
+use crate::render::ui_painter::{UiPainter, UiPainterKind};
 use crate::render::{FrameView, Gpu, Renderer};
 
 /// What the renderer's camera image and occluder were made for: the footage frame, where the
@@ -18,6 +19,9 @@ pub struct ViewDrawer {
     renderer: Renderer,
     egui_ctx: egui::Context,
     egui_renderer: egui_wgpu::Renderer,
+    /// The lean painter that draws the UI instead of `egui_renderer` on a CPU rasteriser's
+    /// window ([`UiPainterKind::Lean`]).
+    lean_ui: Option<UiPainter>,
     tree_mesher: crate::tree_model::TreeMesher,
     /// The garden's other trees (drawn with the selected one).
     garden_mesher: crate::garden_view::GardenMesher,
@@ -34,11 +38,22 @@ impl ViewDrawer {
     /// A drawer for surfaces of `format`, multisampled as suits the adapter for an interactive
     /// view ([`crate::render::interactive_sample_count`]: 4× on a GPU, 1× on a CPU rasteriser).
     pub fn new(gpu: &Gpu, format: wgpu::TextureFormat) -> ViewDrawer {
+        ViewDrawer::with_ui_painter(gpu, format, UiPainterKind::EguiWgpu)
+    }
+
+    /// [`Self::new`] with the UI drawn by `painter` (the lean one on a CPU rasteriser's window,
+    /// [`crate::render::ui_painter::interactive_ui_painter`]).
+    pub fn with_ui_painter(
+        gpu: &Gpu,
+        format: wgpu::TextureFormat,
+        painter: UiPainterKind,
+    ) -> ViewDrawer {
         let samples = crate::render::interactive_sample_count(&gpu.adapter.get_info());
         ViewDrawer {
             renderer: Renderer::with_samples(gpu, format, samples),
             egui_ctx: egui::Context::default(),
             egui_renderer: egui_wgpu::Renderer::new(&gpu.device, format, Default::default()),
+            lean_ui: (painter == UiPainterKind::Lean).then(|| UiPainter::new(&gpu.device, format)),
             tree_mesher: Default::default(),
             garden_mesher: Default::default(),
             meshed_revision: None,
@@ -147,26 +162,35 @@ impl ViewDrawer {
             size_in_pixels: [size.0, size.1],
             pixels_per_point: ppp,
         };
-        for (id, delta) in &output.textures_delta.set {
-            for d in delta {
-                self.egui_renderer
-                    .update_texture(&gpu.device, &gpu.queue, *id, d);
+        let mut callbacks = Vec::new();
+        match self.lean_ui.as_mut() {
+            Some(painter) => {
+                painter.set_textures(&gpu.device, &gpu.queue, &output.textures_delta);
+                painter.prepare(&gpu.device, &gpu.queue, &jobs, size, ppp);
+            }
+            None => {
+                for (id, deltas) in &output.textures_delta.set {
+                    for delta in deltas {
+                        self.egui_renderer
+                            .update_texture(&gpu.device, &gpu.queue, *id, delta);
+                    }
+                }
+                callbacks = self.egui_renderer.update_buffers(
+                    &gpu.device,
+                    &gpu.queue,
+                    &mut encoder,
+                    &jobs,
+                    &screen,
+                );
             }
         }
-        let callbacks = self.egui_renderer.update_buffers(
-            &gpu.device,
-            &gpu.queue,
-            &mut encoder,
-            &jobs,
-            &screen,
-        );
         {
             let load = if player.ui.orbit_view || player.camera().is_some() {
                 wgpu::LoadOp::Load
             } else {
                 wgpu::LoadOp::Clear(wgpu::Color::BLACK)
             };
-            let pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
+            let mut pass = encoder.begin_render_pass(&wgpu::RenderPassDescriptor {
                 label: Some("egui"),
                 color_attachments: &[Some(wgpu::RenderPassColorAttachment {
                     view: target,
@@ -182,11 +206,20 @@ impl ViewDrawer {
                 occlusion_query_set: None,
                 multiview_mask: None,
             });
-            self.egui_renderer
-                .render(&mut pass.forget_lifetime(), &jobs, &screen);
+            match &self.lean_ui {
+                Some(painter) => painter.paint(&mut pass),
+                None => self
+                    .egui_renderer
+                    .render(&mut pass.forget_lifetime(), &jobs, &screen),
+            }
         }
-        for id in &output.textures_delta.free {
-            self.egui_renderer.free_texture(id);
+        match self.lean_ui.as_mut() {
+            Some(painter) => painter.free_textures(&output.textures_delta),
+            None => {
+                for id in &output.textures_delta.free {
+                    self.egui_renderer.free_texture(id);
+                }
+            }
         }
         gpu.queue
             .submit(callbacks.into_iter().chain([encoder.finish()]));

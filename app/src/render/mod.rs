@@ -27,6 +27,7 @@ pub mod resources;
 pub mod shadow;
 pub mod textures;
 mod tree_gpu;
+pub mod ui_painter;
 pub mod upscale;
 
 pub use camera::{Intrinsics, ViewCamera};
