@@ -365,6 +365,7 @@ impl DesktopApp {
                 ui_ms: (draw_ms - render_ms).max(0.0),
                 present_ms: present_started.elapsed().as_secs_f32() * 1000.0,
                 seeking,
+                scene_reused: gfx.drawer.scene_reused(),
                 process_cpu_s,
             };
             times.record(sample, self.player.frame);

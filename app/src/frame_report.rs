@@ -27,6 +27,9 @@ pub struct FrameSample {
     pub present_ms: f32,
     /// The redraw happened while a seek was still catching up.
     pub seeking: bool,
+    /// The redraw stretched the AR view it drew before (nothing in it had changed: no new
+    /// footage frame yet) under the redrawn UI, instead of drawing the AR view again.
+    pub scene_reused: bool,
     /// CPU time the process had used at the start of the redraw, seconds ([`process_cpu_s`]).
     pub process_cpu_s: f64,
 }
@@ -135,6 +138,7 @@ impl FrameTimes {
             cpu_ms_per_frame: cpu_ms_per_frame(&self.samples),
             load_average: load_average(),
             num_drawn_while_seeking: self.num_seek_redraws,
+            num_scene_reused: self.samples.iter().filter(|s| s.scene_reused).count(),
             footage: self.footage.unwrap_or_default(),
         })
     }
@@ -187,6 +191,8 @@ pub struct FrameReport {
     /// Redraws made while a seek was catching up, from the window's first one (the window kept
     /// drawing).
     pub num_drawn_while_seeking: usize,
+    /// Measured redraws that stretched the AR view drawn before instead of drawing it again.
+    pub num_scene_reused: usize,
     /// The first and last footage frame shown while measuring.
     pub footage: (usize, usize),
 }
@@ -195,13 +201,15 @@ impl fmt::Display for FrameReport {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         writeln!(
             f,
-            "frame_report window={}x{} frames={} footage_frames={}..{} drawn_while_seeking={}",
+            "frame_report window={}x{} frames={} footage_frames={}..{} drawn_while_seeking={} \
+             scene_reused={}",
             self.size.0,
             self.size.1,
             self.num_frames,
             self.footage.0,
             self.footage.1,
-            self.num_drawn_while_seeking
+            self.num_drawn_while_seeking,
+            self.num_scene_reused
         )?;
         for (name, stat) in [
             ("frame", self.frame),
@@ -249,6 +257,7 @@ mod tests {
             let sample = FrameSample {
                 frame_ms: i as f32,
                 seeking: i < 5,
+                scene_reused: i % 2 == 1,
                 process_cpu_s: 0.01 * i as f64,
                 ..FrameSample::default()
             };
@@ -263,6 +272,9 @@ mod tests {
         assert_eq!(report.frame.median_ms, (first + 1) as f32);
         assert_eq!(report.num_drawn_while_seeking, 5);
         assert!((report.cpu_ms_per_frame - 10.0).abs() < 1e-3);
+        // Of the measured redraws 10, 11, 12, one stretched the AR view it had drawn before.
+        assert_eq!(report.num_scene_reused, 1);
         assert!(report.to_string().contains("frames=3"));
+        assert!(report.to_string().contains("scene_reused=1"));
     }
 }

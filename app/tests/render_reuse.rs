@@ -2,7 +2,8 @@
 //! only when the tree, the sun or the drawn level change, not when the camera moves, and a frame
 //! drawn with the kept map is the frame a fresh renderer draws; the one-sample scene pass of an
 //! interactive view on a CPU rasteriser keeps the 4× frame's look (alpha-tested leaf edges), and
-//! so does its scene drawn at the footage's resolution and stretched over a larger window.
+//! so does its scene drawn at the footage's resolution and stretched over a larger window, which
+//! is kept and stretched again while nothing it shows changes (no new camera, image or mesh).
 //!
 //! Run: `XDG_RUNTIME_DIR=/tmp/sylva-xdg WGPU_BACKEND=vulkan cargo test --release -p sylva-app --test render_reuse`
 
@@ -188,4 +189,53 @@ fn the_scene_at_the_footage_resolution_stretched_over_a_larger_window_keeps_its_
         differing < covered_a / 3,
         "{differing} of {covered_a} drawn pixels differ"
     );
+}
+
+#[test]
+fn the_scene_at_the_footage_resolution_is_drawn_again_only_when_what_it_shows_changes() {
+    let gpu = gpu();
+    let tree = sylva_app::tree_model::golden_tree_mesh();
+    let (width, height) = (2 * WIDTH + 100, 2 * HEIGHT);
+    let target = Offscreen::new(&gpu.device, width, height);
+    let mut reduced = renderer(&gpu, &tree, 1);
+    reduced.set_scene_resolution(SceneResolution::Footage);
+    let view = view_from(&tree, Vec3::new(0.0, 2.5, -2.2));
+    let first = target.render(&gpu, &mut reduced, &view).expect("frame");
+    assert!(!reduced.scene_reused(), "the first frame draws the scene");
+    let again = target.render(&gpu, &mut reduced, &view).expect("frame");
+    assert!(reduced.scene_reused(), "the same view of the same uploads");
+    assert!(!reduced.shadow_redrawn());
+    assert_eq!(
+        num_differing(&first, &again, 0),
+        0,
+        "the kept scene is the one drawn"
+    );
+
+    // A camera move, a new camera image, a new tree and a new occluder each draw it again.
+    let moved = view_from(&tree, Vec3::new(0.4, 2.3, -2.4));
+    let after_move = target.render(&gpu, &mut reduced, &moved).expect("frame");
+    assert!(!reduced.scene_reused(), "a camera move draws the scene");
+    assert!(num_differing(&after_move, &first, 12) > 100);
+    target.render(&gpu, &mut reduced, &moved).expect("frame");
+    assert!(reduced.scene_reused());
+    let darker = RgbaImage::from_pixel(WIDTH, HEIGHT, Rgba([60, 60, 60, 255]));
+    reduced.set_camera_image(&gpu, darker.as_raw(), intrinsics());
+    let new_image = target.render(&gpu, &mut reduced, &moved).expect("frame");
+    assert!(
+        !reduced.scene_reused(),
+        "a new camera image draws the scene"
+    );
+    assert!(num_differing(&new_image, &after_move, 40) > 1000);
+    reduced.set_tree(&gpu, &tree);
+    target.render(&gpu, &mut reduced, &moved).expect("frame");
+    assert!(!reduced.scene_reused(), "a new tree draws the scene");
+    reduced.set_occluder(&gpu, &Default::default());
+    target.render(&gpu, &mut reduced, &moved).expect("frame");
+    assert!(!reduced.scene_reused(), "a new occluder draws the scene");
+
+    // Drawn at full resolution (into the target itself) nothing is kept.
+    let mut full = renderer(&gpu, &tree, 1);
+    target.render(&gpu, &mut full, &view).expect("frame");
+    target.render(&gpu, &mut full, &view).expect("frame");
+    assert!(!full.scene_reused());
 }

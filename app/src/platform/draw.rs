@@ -32,6 +32,8 @@ pub struct ViewDrawer {
     uploaded_frame: Option<Uploaded>,
     /// How the camera image is shown (turned upright, filling the view on a phone).
     display: DisplayTransform,
+    /// The last frame stretched the AR view drawn before instead of drawing it again.
+    scene_reused: bool,
 }
 
 impl ViewDrawer {
@@ -60,6 +62,7 @@ impl ViewDrawer {
             orbit: None,
             uploaded_frame: None,
             display: DisplayTransform::default(),
+            scene_reused: false,
         }
     }
 
@@ -82,6 +85,12 @@ impl ViewDrawer {
     /// The surface format this drawer renders for.
     pub fn format(&self) -> wgpu::TextureFormat {
         self.renderer.color_format()
+    }
+
+    /// Whether the last frame stretched the AR view it drew before (see
+    /// [`Renderer::scene_reused`]).
+    pub fn scene_reused(&self) -> bool {
+        self.scene_reused
     }
 
     /// Draws the AR view at `resolution` (see [`crate::render::SceneResolution`]).
@@ -235,6 +244,7 @@ impl ViewDrawer {
         target: &wgpu::TextureView,
         size: (u32, u32),
     ) {
+        self.scene_reused = false;
         if player.ui.orbit_view {
             // Outside AR: the tree alone on a lawn, seen by the orbiting camera.
             let tree = &player.design.tree;
@@ -256,6 +266,7 @@ impl ViewDrawer {
             let camera = orbit.camera(player.footage.intrinsics);
             self.renderer
                 .render(gpu, encoder, target, size, &FrameView::tree_only(camera));
+            self.scene_reused = self.renderer.scene_reused();
         } else if let Some(camera) = player.camera_in_tree() {
             let camera = self.display.shown_camera(&camera, size);
             // The frame is drawn in tree space (the tree's mesh is), after planting.
@@ -310,6 +321,7 @@ impl ViewDrawer {
             view.debug.depth_wireframe = player.ui.show_debug;
             view.debug.brush = player.brush_sphere();
             self.renderer.render(gpu, encoder, target, size, &view);
+            self.scene_reused = self.renderer.scene_reused();
         }
     }
 }

@@ -57,6 +57,17 @@ struct ShadowKey {
     light_clip_from_world: Mat4,
 }
 
+/// What the reduced-resolution scene texture was drawn for: it is drawn again only when one of
+/// these changes (a new footage frame brings a new image, occluder and camera), else the window
+/// only stretches it again under the redrawn UI.
+#[derive(Clone, Debug, PartialEq)]
+struct SceneKey {
+    view: FrameView,
+    scene_size: (u32, u32),
+    /// Counts uploads of trees, camera images, occluders and feature points.
+    uploads: u64,
+}
+
 struct Background {
     texture: wgpu::Texture,
     intrinsics: Intrinsics,
@@ -81,6 +92,12 @@ pub struct Renderer {
     shadow_drawn: Option<ShadowKey>,
     /// Whether the last frame drew the shadow map (rather than reusing it).
     shadow_redrawn: bool,
+    /// Counts every upload a frame shows (trees, camera image, occluder, feature points).
+    uploads: u64,
+    /// What the reduced-resolution scene texture holds (None before it is drawn).
+    scene_drawn: Option<SceneKey>,
+    /// Whether the last frame stretched the kept scene texture without drawing the scene.
+    scene_reused: bool,
     /// The garden's other trees (slots 1..), drawn as the tree is, each at its own level.
     others: Vec<GpuTree>,
     /// The level of detail the last frame drew.
@@ -210,6 +227,9 @@ impl Renderer {
             tree_generation: 0,
             shadow_drawn: None,
             shadow_redrawn: false,
+            uploads: 0,
+            scene_drawn: None,
+            scene_reused: false,
             others: Vec::new(),
             drawn_level: 0,
             occluder: None,
@@ -247,11 +267,18 @@ impl Renderer {
         self.shadow_redrawn
     }
 
+    /// Whether the last frame, drawn at a reduced resolution, stretched the scene it drew before
+    /// (the same view of the same uploads) instead of drawing it again.
+    pub fn scene_reused(&self) -> bool {
+        self.scene_reused
+    }
+
     /// Uploads the tree (replacing the previous one): every level of detail, and the species'
     /// leaf card and bark textures when its look differs from the last tree's.
     pub fn set_tree(&mut self, gpu: &Gpu, tree: &TreeMesh) {
         self.tree.set(gpu, &self.pipelines, tree);
         self.tree_generation += 1;
+        self.uploads += 1;
     }
 
     /// Uploads tree `slot` of a garden (0: the tree [`Self::set_tree`] sets; the others, in
@@ -265,6 +292,7 @@ impl Renderer {
         }
         self.others[other].set(gpu, &self.pipelines, tree);
         self.tree_generation += 1;
+        self.uploads += 1;
     }
 
     /// Keeps the first `num_trees` garden slots (at least the tree's), dropping the rest.
@@ -273,6 +301,7 @@ impl Renderer {
         if kept < self.others.len() {
             self.others.truncate(kept);
             self.tree_generation += 1;
+            self.uploads += 1;
         }
     }
 
@@ -338,12 +367,14 @@ impl Renderer {
         let positions: Vec<[f32; 3]> = mesh.positions.iter().map(|p| p.to_array()).collect();
         self.occluder = upload(&gpu.device, &positions, Some(&mesh.indices));
         self.wireframe = upload(&gpu.device, &mesh.wireframe(), None);
+        self.uploads += 1;
     }
 
     /// Uploads the tracked feature points (world space) for the debug view.
     pub fn set_feature_points(&mut self, gpu: &Gpu, points: &[Vec3]) {
         let positions: Vec<[f32; 3]> = points.iter().map(|p| p.to_array()).collect();
         self.points = upload(&gpu.device, &positions, None);
+        self.uploads += 1;
     }
 
     /// Uploads a camera image (tightly packed RGBA8, sRGB) taken with `intrinsics`. An image
@@ -351,6 +382,7 @@ impl Renderer {
     /// in normalised coordinates, so the intrinsics stay those of the full image); one whose
     /// byte count does not match its intrinsics is not shown.
     pub fn set_camera_image(&mut self, gpu: &Gpu, rgba: &[u8], intrinsics: Intrinsics) {
+        self.uploads += 1;
         let full = (intrinsics.width, intrinsics.height);
         let expected_len = u64::from(full.0) * u64::from(full.1) * 4;
         if full.0 == 0 || full.1 == 0 || rgba.len() as u64 != expected_len {
@@ -438,10 +470,12 @@ impl Renderer {
         size: (u32, u32),
         view: &FrameView,
     ) {
+        self.scene_reused = false;
         let Some(scene_size) = self
             .scene_resolution
             .reduced_size(size, &view.camera.intrinsics)
         else {
+            self.scene_drawn = None;
             return self.render_direct(gpu, encoder, target, size, view);
         };
         let mut upscaler = self
@@ -449,7 +483,19 @@ impl Renderer {
             .take()
             .unwrap_or_else(|| Upscaler::new(&gpu.device, self.color_format));
         let scene = upscaler.scene_target(&gpu.device, scene_size, self.color_format);
-        self.render_direct(gpu, encoder, &scene, scene_size, view);
+        let key = SceneKey {
+            view: *view,
+            scene_size,
+            uploads: self.uploads,
+        };
+        if self.scene_drawn.as_ref() == Some(&key) && upscaler.holds(scene_size) {
+            // Nothing the scene shows changed: its texture is stretched again as it is.
+            self.scene_reused = true;
+            self.shadow_redrawn = false;
+        } else {
+            self.render_direct(gpu, encoder, &scene, scene_size, view);
+            self.scene_drawn = Some(key);
+        }
         upscaler.stretch(encoder, target, letterbox(size, &view.camera.intrinsics));
         self.upscaler = Some(upscaler);
     }

@@ -180,6 +180,11 @@ impl Upscaler {
         view
     }
 
+    /// Whether the scene texture of `size` exists (and holds what was last drawn into it).
+    pub fn holds(&self, size: (u32, u32)) -> bool {
+        self.target.as_ref().is_some_and(|t| t.size == size)
+    }
+
     /// Records the pass that clears `target` and stretches the scene texture over `region`
     /// (x, y, w, h pixels of the target).
     pub fn stretch(
