@@ -30,7 +30,11 @@ pub enum UiPainterKind {
 /// The painter for an interactive view's UI on `adapter`: the lean one on a CPU rasteriser,
 /// egui-wgpu's on a GPU.
 pub fn interactive_ui_painter(adapter: &wgpu::AdapterInfo) -> UiPainterKind {
-    match adapter.device_type {
+    painter_for(adapter.device_type)
+}
+
+fn painter_for(device_type: wgpu::DeviceType) -> UiPainterKind {
+    match device_type {
         wgpu::DeviceType::Cpu => UiPainterKind::Lean,
         _ => UiPainterKind::EguiWgpu,
     }
@@ -535,21 +539,14 @@ mod tests {
 
     #[test]
     fn the_lean_painter_is_chosen_only_for_cpu_rasterisers() {
-        let mut info = wgpu::AdapterInfo {
-            name: String::new(),
-            vendor: 0,
-            device: 0,
-            device_type: wgpu::DeviceType::Cpu,
-            device_pci_bus_id: String::new(),
-            driver: String::new(),
-            driver_info: String::new(),
-            backend: wgpu::Backend::Vulkan,
-            subgroup_min_size: 0,
-            subgroup_max_size: 0,
-            transient_saves_memory: None,
-        };
-        assert_eq!(interactive_ui_painter(&info), UiPainterKind::Lean);
-        info.device_type = wgpu::DeviceType::DiscreteGpu;
-        assert_eq!(interactive_ui_painter(&info), UiPainterKind::EguiWgpu);
+        assert_eq!(painter_for(wgpu::DeviceType::Cpu), UiPainterKind::Lean);
+        for gpu in [
+            wgpu::DeviceType::DiscreteGpu,
+            wgpu::DeviceType::IntegratedGpu,
+            wgpu::DeviceType::VirtualGpu,
+            wgpu::DeviceType::Other,
+        ] {
+            assert_eq!(painter_for(gpu), UiPainterKind::EguiWgpu);
+        }
     }
 }
