@@ -1,7 +1,6 @@
 //! Issue 22, item 4: the tracker on its portable vision backend (the one phones run, no OpenCV)
 //! on the whole of TUM fr1_rpy, held to the bounds `track_fr1_rpy.rs` holds the OpenCV backend
-//! to, except the scale spread: the issue's 1.5 is not met yet (measured 2.03; OpenCV's
-//! backend 1.38), so this test holds the portable backend to what it does, 2.2, until it is.
+//! to.
 
 use sylva_tests::shared_data_dir;
 use sylva_tracking::report::run_sequence;
@@ -28,7 +27,6 @@ fn fr1_rpy_on_the_portable_backend_meets_the_desktop_bounds() {
     assert!(report.tracked_fraction >= 0.90, "{line}");
     assert!(e.ate_rmse_m <= 0.035, "{line}");
     assert!(e.window_ate_m <= 0.015, "{line}");
-    // The issue's bound is 1.5 (see the module's note).
-    assert!(e.scale_spread <= 2.2, "{line}");
+    assert!(e.scale_spread <= 1.5, "{line}");
     assert!(e.rot_err_deg <= 2.0, "{line}");
 }

@@ -7,6 +7,7 @@
 pub mod corners;
 pub mod epipolar;
 pub mod orb;
+pub mod orb_pattern;
 pub mod pnp;
 
 pub use corners::detect_corners;

@@ -1,12 +1,15 @@
 //! ORB descriptors (Rublee et al., "ORB: an efficient alternative to SIFT or SURF", 2011) of
 //! given points: the intensity-centroid orientation (Rosin's moments over a disc of radius 15),
 //! then 256 binary intensity tests on the image smoothed by a 7 × 7 Gaussian (σ = 2), their
-//! point pairs rotated by that orientation. The test pattern is generated here, once, from a
-//! fixed seed: BRIEF's isotropic Gaussian sampling (Calonder et al. 2010, G II, σ = S / 5 for
-//! the 31-pixel patch) kept inside a disc of radius 13, so that every rotation stays in the
-//! patch. Hamming distance and the ratio test for matching.
+//! point pairs rotated by that orientation. The test pattern is learned as ORB's was (§4.3,
+//! [`learn_pattern`]): of all pairs of points in the patch, steered, the tests with the most
+//! variance that are least correlated with each other, chosen greedily on training patches
+//! (committed in [`super::orb_pattern`], learned on TUM fr3_cabinet, not on the fr1_rpy footage
+//! the tracker is held to). BRIEF's random Gaussian pairs, which this backend used before, lose
+//! much of their variance and decorrelation once steered (ORB §4.2): their distances between
+//! different points are small, so more wrong matches pass the tracker's Hamming limits. Hamming
+//! distance and the ratio test for matching.
 
-use super::SplitMix64;
 use crate::frame::GrayImage;
 use glam::Vec2;
 
@@ -15,12 +18,6 @@ pub type Descriptor = [u8; 32];
 
 /// Radius of ORB's orientation patch (half its 31-pixel patch).
 pub const ORIENTATION_RADIUS: i32 = 15;
-/// Radius every test point lies within, before and after rotation.
-const PATTERN_RADIUS: f64 = 13.0;
-/// BRIEF's σ for a 31-pixel patch: S / 5.
-const PATTERN_SIGMA: f64 = 31.0 / 5.0;
-/// Seed of the generated test pattern. Changing it changes every descriptor.
-const PATTERN_SEED: u64 = 0x0B0B_5EED;
 /// Points nearer the border than this get no descriptor: ORB's edge threshold (its 31-pixel
 /// patch), as OpenCV's ORB drops given keypoints. Near the border lens distortion and the
 /// rolling shutter change a patch most from view to view.
@@ -92,27 +89,174 @@ impl<T> NearestTwo<T> {
     }
 }
 
-/// The 256 test pairs, generated from [`PATTERN_SEED`].
-fn generate_pattern() -> Vec<[(f32, f32); 2]> {
-    let mut rng = SplitMix64::new(PATTERN_SEED);
-    let mut gaussian_point = || loop {
-        // Box–Muller: two independent normals.
-        let (u1, u2) = (rng.unit().max(1e-300), rng.unit());
-        let radius = (-2.0 * u1.ln()).sqrt() * PATTERN_SIGMA;
-        let theta = std::f64::consts::TAU * u2;
-        let (x, y) = (radius * theta.cos(), radius * theta.sin());
-        if x * x + y * y <= PATTERN_RADIUS * PATTERN_RADIUS {
-            break (x.round() as f32, y.round() as f32);
-        }
-    };
-    let mut pattern = Vec::with_capacity(256);
-    while pattern.len() < 256 {
-        let (a, b) = (gaussian_point(), gaussian_point());
-        if a != b {
-            pattern.push([a, b]);
+/// Radius of the disc the candidate test points of [`learn_pattern`] lie in: ORB's patch.
+pub const LEARN_RADIUS: i32 = 15;
+/// Spacing of the candidate test points, pixels: the smoothing's σ (finer points only repeat
+/// their neighbours' values).
+pub const LEARN_STEP: i32 = 2;
+
+/// The candidate test points [`learn_pattern`] picks pairs of: a grid [`LEARN_STEP`] apart
+/// inside the disc of radius [`LEARN_RADIUS`] (rotations keep them inside ORB's patch, and the
+/// patch inside [`EDGE_THRESHOLD_PX`] of the border).
+pub fn candidate_points() -> Vec<(i8, i8)> {
+    let r = LEARN_RADIUS;
+    let mut points = Vec::new();
+    for y in (-r..=r).step_by(LEARN_STEP as usize) {
+        for x in (-r..=r).step_by(LEARN_STEP as usize) {
+            if x * x + y * y <= r * r {
+                points.push((x as i8, y as i8));
+            }
         }
     }
-    pattern
+    points
+}
+
+/// The smoothed values at `points` around `p`, the points rotated by `angle_deg` and rounded
+/// as the descriptor samples them.
+fn sample_points(
+    smoothed: &[f32],
+    width: usize,
+    p: Vec2,
+    angle_deg: f32,
+    points: &[(f32, f32)],
+) -> Vec<f32> {
+    let (cx, cy) = (p.x.round() as i32, p.y.round() as i32);
+    let (sin, cos) = angle_deg.to_radians().sin_cos();
+    points
+        .iter()
+        .map(|&(x, y)| {
+            let u = (x * cos - y * sin).round() as i32;
+            let v = (x * sin + y * cos).round() as i32;
+            smoothed[(cy + v) as usize * width + (cx + u) as usize]
+        })
+        .collect()
+}
+
+/// Training samples for [`learn_pattern`]: for each of `corners` far enough from the border,
+/// the smoothed image at every [`candidate_points`] point, steered by the corner's
+/// intensity-centroid orientation exactly as descriptors are.
+pub fn training_samples(image: &GrayImage, corners: &[Vec2]) -> Vec<Vec<f32>> {
+    let (w, h) = (image.width as i32, image.height as i32);
+    let e = EDGE_THRESHOLD_PX;
+    let points: Vec<(f32, f32)> = candidate_points()
+        .into_iter()
+        .map(|(x, y)| (f32::from(x), f32::from(y)))
+        .collect();
+    let inside: Vec<(Vec2, f32)> = corners
+        .iter()
+        .filter(|p| {
+            let (x, y) = (p.x.round() as i32, p.y.round() as i32);
+            x >= e && y >= e && x < w - e && y < h - e
+        })
+        .filter_map(|p| Some((*p, intensity_centroid_angle_deg(image, *p)?)))
+        .collect();
+    if inside.is_empty() {
+        return Vec::new();
+    }
+    let smoothed = smooth(image);
+    inside
+        .into_iter()
+        .map(|(p, angle)| sample_points(&smoothed, w as usize, p, angle, &points))
+        .collect()
+}
+
+/// A binary test's outcomes over the training samples, packed 64 to a word.
+struct TestBits {
+    pair: (u16, u16),
+    bits: Vec<u64>,
+    ones: u32,
+}
+
+/// ORB's learned test pattern (Rublee et al. 2011, §4.3) from `samples` (rows of
+/// [`training_samples`]): every pair of [`candidate_points`] at least [`LEARN_STEP`] apart is a
+/// candidate test; candidates are ordered by how near their mean over the samples is to 0.5
+/// (high variance), then taken greedily, each kept only if its correlation with every test
+/// kept so far is at most a threshold, raised from 0.2 in steps of 0.05 until `count` tests
+/// are kept. Steered tests that are nearly always the same, or that repeat each other, add no
+/// information to a descriptor; random ones (BRIEF's) lose much of it once steered. None when
+/// there are too few samples (under 64) or candidates.
+pub fn learn_pattern(samples: &[Vec<f32>], count: usize) -> Option<Vec<[(i8, i8); 2]>> {
+    let points = candidate_points();
+    if samples.len() < 64 || samples.iter().any(|s| s.len() != points.len()) {
+        return None;
+    }
+    let words = samples.len().div_ceil(64);
+    let n = samples.len() as f64;
+    let min_d2 = LEARN_STEP * LEARN_STEP;
+    let mut tests: Vec<TestBits> = Vec::new();
+    for a in 0..points.len() {
+        for b in a + 1..points.len() {
+            let (pa, pb) = (points[a], points[b]);
+            let (dx, dy) = (i32::from(pa.0 - pb.0), i32::from(pa.1 - pb.1));
+            if dx * dx + dy * dy < min_d2 {
+                continue;
+            }
+            let mut bits = vec![0u64; words];
+            for (k, s) in samples.iter().enumerate() {
+                if s[a] < s[b] {
+                    bits[k / 64] |= 1 << (k % 64);
+                }
+            }
+            let ones = bits.iter().map(|w| w.count_ones()).sum();
+            tests.push(TestBits {
+                pair: (a as u16, b as u16),
+                bits,
+                ones,
+            });
+        }
+    }
+    // Nearest 0.5 first; ties in candidate order, so the result is deterministic.
+    let balance = |t: &TestBits| (f64::from(t.ones) / n - 0.5).abs();
+    tests.sort_by(|x, y| balance(x).total_cmp(&balance(y)).then(x.pair.cmp(&y.pair)));
+    let correlation = |x: &TestBits, y: &TestBits| {
+        let both: u32 = x
+            .bits
+            .iter()
+            .zip(&y.bits)
+            .map(|(a, b)| (a & b).count_ones())
+            .sum();
+        let (px, py) = (f64::from(x.ones) / n, f64::from(y.ones) / n);
+        let var = (px * (1.0 - px) * py * (1.0 - py)).sqrt();
+        if var <= 1e-12 {
+            1.0
+        } else {
+            ((f64::from(both) / n - px * py) / var).abs()
+        }
+    };
+    let mut threshold = 0.2;
+    while threshold <= 1.0 + 1e-9 {
+        let mut kept: Vec<usize> = Vec::with_capacity(count);
+        for (i, t) in tests.iter().enumerate() {
+            if kept.iter().all(|&k| correlation(&tests[k], t) <= threshold) {
+                kept.push(i);
+                if kept.len() == count {
+                    return Some(
+                        kept.iter()
+                            .map(|&k| {
+                                let (a, b) = tests[k].pair;
+                                [points[a as usize], points[b as usize]]
+                            })
+                            .collect(),
+                    );
+                }
+            }
+        }
+        threshold += 0.05;
+    }
+    None
+}
+
+/// The 256 test pairs of [`LEARNED_PATTERN`](super::orb_pattern::LEARNED_PATTERN).
+fn learned_pattern() -> Vec<[(f32, f32); 2]> {
+    super::orb_pattern::LEARNED_PATTERN
+        .iter()
+        .map(|&[ax, ay, bx, by]| {
+            [
+                (f32::from(ax), f32::from(ay)),
+                (f32::from(bx), f32::from(by)),
+            ]
+        })
+        .collect()
 }
 
 /// The 7 × 7 Gaussian (σ = 2) smoothing the descriptor's tests see, borders reflected.
@@ -180,7 +324,23 @@ impl Default for Orb {
 impl Orb {
     pub fn new() -> Self {
         Self {
-            pattern: generate_pattern(),
+            pattern: learned_pattern(),
+        }
+    }
+
+    /// ORB with another test pattern (pairs of points within [`LEARN_RADIUS`]), for learning
+    /// and comparing patterns.
+    pub fn with_pattern(pattern: &[[(i8, i8); 2]]) -> Self {
+        Self {
+            pattern: pattern
+                .iter()
+                .map(|&[a, b]| {
+                    [
+                        (f32::from(a.0), f32::from(a.1)),
+                        (f32::from(b.0), f32::from(b.1)),
+                    ]
+                })
+                .collect(),
         }
     }
 
@@ -252,6 +412,7 @@ impl Orb {
 
 #[cfg(test)]
 mod tests {
+    use super::super::SplitMix64;
     use super::*;
 
     /// A textured image: smooth blobs of several sizes.
@@ -295,16 +456,93 @@ mod tests {
     }
 
     #[test]
-    fn pattern_is_fixed_and_inside_the_patch() {
-        let (a, b) = (generate_pattern(), generate_pattern());
-        assert_eq!(a, b);
-        assert_eq!(a.len(), 256);
+    fn the_learned_pattern_is_256_distinct_pairs_inside_the_patch() {
+        let pattern = learned_pattern();
+        assert_eq!(pattern.len(), 256);
+        let r = LEARN_RADIUS as f32;
+        let step = LEARN_STEP as f32;
+        for (k, [a, b]) in pattern.iter().enumerate() {
+            assert!(a.0 * a.0 + a.1 * a.1 <= r * r && b.0 * b.0 + b.1 * b.1 <= r * r);
+            assert!(
+                (a.0 - b.0).powi(2) + (a.1 - b.1).powi(2) >= step * step,
+                "{a:?} {b:?}"
+            );
+            assert!(!pattern[k + 1..].contains(&[*a, *b]), "pair {k} repeats");
+        }
+    }
+
+    /// Mean |correlation| over all pairs of tests, and mean |mean − 0.5|, of `pattern` on the
+    /// samples (points given as indices into [`candidate_points`]).
+    fn pattern_statistics(samples: &[Vec<f32>], pattern: &[[(i8, i8); 2]]) -> (f64, f64) {
+        let points = candidate_points();
+        let index = |p: (i8, i8)| points.iter().position(|q| *q == p).expect("candidate");
+        let bits: Vec<Vec<f64>> = pattern
+            .iter()
+            .map(|[a, b]| {
+                let (a, b) = (index(*a), index(*b));
+                samples
+                    .iter()
+                    .map(|s| if s[a] < s[b] { 1.0 } else { 0.0 })
+                    .collect()
+            })
+            .collect();
+        let n = samples.len() as f64;
+        let means: Vec<f64> = bits.iter().map(|b| b.iter().sum::<f64>() / n).collect();
+        let (mut total, mut pairs) = (0.0, 0usize);
+        for i in 0..bits.len() {
+            for j in i + 1..bits.len() {
+                let cov = bits[i]
+                    .iter()
+                    .zip(&bits[j])
+                    .map(|(x, y)| (x - means[i]) * (y - means[j]))
+                    .sum::<f64>()
+                    / n;
+                let var = (means[i] * (1.0 - means[i]) * means[j] * (1.0 - means[j])).sqrt();
+                total += if var > 1e-12 { (cov / var).abs() } else { 1.0 };
+                pairs += 1;
+            }
+        }
+        let balance = means.iter().map(|m| (m - 0.5).abs()).sum::<f64>() / means.len() as f64;
+        (total / pairs as f64, balance)
+    }
+
+    #[test]
+    fn learning_keeps_balanced_decorrelated_tests() {
+        let mut samples = Vec::new();
+        for seed in 0..6 {
+            let img = texture(240, 240, 10 + seed);
+            let corners = super::super::detect_corners(&img, 200, 6.0, &[]);
+            samples.extend(training_samples(&img, &corners));
+        }
+        assert!(samples.len() >= 200, "{} samples", samples.len());
+        assert_eq!(learn_pattern(&samples[..63], 64), None);
+        let learned = learn_pattern(&samples, 64).expect("a pattern");
+        assert_eq!(learn_pattern(&samples, 64).as_ref(), Some(&learned));
+        // The same number of random pairs of candidate points, for comparison.
+        let points = candidate_points();
+        let mut rng = SplitMix64::new(5);
+        let random: Vec<[(i8, i8); 2]> = (0..64)
+            .map(|_| {
+                loop {
+                    let (a, b) = (
+                        points[rng.below(points.len())],
+                        points[rng.below(points.len())],
+                    );
+                    let d2 = (i32::from(a.0) - i32::from(b.0)).pow(2)
+                        + (i32::from(a.1) - i32::from(b.1)).pow(2);
+                    if d2 >= LEARN_STEP * LEARN_STEP {
+                        break [a, b];
+                    }
+                }
+            })
+            .collect();
+        let (learned_corr, learned_balance) = pattern_statistics(&samples, &learned);
+        let (random_corr, random_balance) = pattern_statistics(&samples, &random);
         assert!(
-            a.iter()
-                .flatten()
-                .all(|(x, y)| x * x + y * y <= 13.5 * 13.5)
+            learned_corr < 0.8 * random_corr && learned_balance < random_balance,
+            "learned |corr| {learned_corr:.3}, |mean − ½| {learned_balance:.3}; random \
+             {random_corr:.3}, {random_balance:.3}"
         );
-        assert!(a.iter().all(|[p, q]| p != q));
     }
 
     #[test]
