@@ -21,7 +21,7 @@
 use glam::{IVec3, Vec2, Vec3};
 use rayon::prelude::*;
 
-use super::cell_hash::{self, cell_set_with_capacity};
+use super::cell_hash::CellBits;
 use super::index::{CellSet, NodeIndex};
 use super::shade::ShadeCover;
 use super::{Garden, GardenTree};
@@ -138,14 +138,15 @@ pub(super) fn link_neighbours(garden: &mut Garden) {
 
 /// Cells of `size` metres holding, or next to one holding, a place where tree `t` (its own
 /// space) can take attraction points this iteration: its nodes with a living bud and its
-/// persistent points.
-fn contact_cells(t: &GardenTree, size: f32) -> cell_hash::CellSet {
+/// persistent points. Returns the cells that hold such a place (each once) and the set of
+/// those cells each with the 26 around it, so that a neighbour's node needs one look-up.
+fn contact_cells(t: &GardenTree, size: f32) -> (Vec<IVec3>, CellBits) {
     let cell = |p: Vec3| (p / size).floor().as_ivec3();
     let tree = &t.tree;
     let buds = tree.skeleton.internodes.iter().filter(|n| {
         n.terminal_bud.as_ref().is_some_and(|b| b.alive) || n.lateral_buds.iter().any(|b| b.alive)
     });
-    let own: cell_hash::CellSet = buds
+    let places: Vec<IVec3> = buds
         .map(|n| cell(n.end))
         .chain(
             tree.environment
@@ -155,18 +156,28 @@ fn contact_cells(t: &GardenTree, size: f32) -> cell_hash::CellSet {
                 .map(|p| cell(p.position)),
         )
         .collect();
-    // Each cell with the 26 around it, so that a neighbour's node needs one look-up.
-    let mut cells = cell_set_with_capacity(own.len() * 4);
-    for c in own {
+    let (lo, hi) = places.iter().fold(
+        (IVec3::splat(i32::MAX), IVec3::splat(i32::MIN)),
+        |(lo, hi), &c| (lo.min(c), hi.max(c)),
+    );
+    let mut own = CellBits::with_box(lo, hi);
+    let mut cells =
+        CellBits::with_box(lo.saturating_sub(IVec3::ONE), hi.saturating_add(IVec3::ONE));
+    let mut each = Vec::new();
+    for c in places {
+        if !own.insert(c) {
+            continue;
+        }
+        each.push(c);
         for dx in -1..=1 {
             for dy in -1..=1 {
                 for dz in -1..=1 {
-                    cells.insert(c + IVec3::new(dx, dy, dz));
+                    cells.insert(c.saturating_add(IVec3::new(dx, dy, dz)));
                 }
             }
         }
     }
-    cells
+    (each, cells)
 }
 
 /// Gives every tree that is `due` the nodes of its linked neighbours that can take an
@@ -187,14 +198,15 @@ pub(super) fn gather_neighbour_nodes(garden: &mut Garden, due: &[bool]) {
             let size = (2.0 * s.occupancy_radius_internodes + s.perception_distance_internodes)
                 * s.internode_length_m
                 + REACH_SLACK_M;
-            let cells = contact_cells(t, size);
+            let (places, cells) = contact_cells(t, size);
             let base = t.base();
-            let (mut lo, mut hi) = (IVec3::splat(i32::MAX), IVec3::splat(i32::MIN));
+            // The index cells the 27 cells around each place touch (a superset of those
+            // holding a node in `cells`: each node is tested below).
             let mut asked = CellSet::default();
-            for &c in &cells {
-                (lo, hi) = (lo.min(c), hi.max(c));
-                let corner = c.as_vec3() * size;
-                asked.add_box(base + corner, base + corner + Vec3::splat(size));
+            for c in places {
+                let lo = c.saturating_sub(IVec3::ONE).as_vec3();
+                let hi = c.saturating_add(IVec3::splat(2)).as_vec3();
+                asked.add_box(base + lo * size, base + hi * size);
             }
             let mut nodes = Vec::new();
             for &j in &t.neighbours {
@@ -202,8 +214,7 @@ pub(super) fn gather_neighbour_nodes(garden: &mut Garden, due: &[bool]) {
                 let offset = n.base() - base;
                 n.node_index.for_each_in(&asked, |end| {
                     let p = end + offset;
-                    let c = floor_to_ivec3(p / size);
-                    if c.cmpge(lo).all() && c.cmple(hi).all() && cells.contains(&c) {
+                    if cells.contains(floor_to_ivec3(p / size)) {
                         nodes.push(p);
                     }
                 });
@@ -363,6 +374,20 @@ pub(super) struct NodeChanges {
     removed: Vec<Vec3>,
     /// The added nodes in the tree's own space (as its grid reads them).
     added_in_tree: Vec<Vec3>,
+    /// The boxes of `added` and of `removed` (lo above hi when empty).
+    added_box: (Vec3, Vec3),
+    removed_box: (Vec3, Vec3),
+}
+
+/// The box of the finite `points` (lo above hi when there are none; a point that is not
+/// finite casts no shade, so it takes no part).
+fn box_of(points: &[Vec3]) -> (Vec3, Vec3) {
+    points
+        .iter()
+        .filter(|p| p.is_finite())
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| {
+            (lo.min(p), hi.max(p))
+        })
 }
 
 impl NodeChanges {
@@ -401,14 +426,17 @@ impl NodeChanges {
             }
         }
         if !matched {
-            return NodeChanges {
-                added: nodes.iter().map(|n| base + n.end).collect(),
-                removed: before.to_vec(),
-                added_in_tree: nodes.iter().map(|n| n.end).collect(),
-            };
+            (added, removed, added_in_tree) = (
+                nodes.iter().map(|n| base + n.end).collect(),
+                before.to_vec(),
+                nodes.iter().map(|n| n.end).collect(),
+            );
+        } else {
+            removed.extend(old.copied());
         }
-        removed.extend(old.copied());
         NodeChanges {
+            added_box: box_of(&added),
+            removed_box: box_of(&removed),
             added,
             removed,
             added_in_tree,
@@ -452,8 +480,13 @@ pub(super) fn hand_on_shade(garden: &mut Garden, changes: &[Option<NodeChanges>]
             for &j in &t.neighbours {
                 if let Some(c) = &changes[j as usize] {
                     let near = |p: &Vec3| cover.covers(*p);
-                    cast.extend(c.added.iter().map(|&p| p - base).filter(near));
-                    uncast.extend(c.removed.iter().map(|&p| p - base).filter(near));
+                    let meets = |(lo, hi): (Vec3, Vec3)| cover.may_cover_box(lo - base, hi - base);
+                    if meets(c.added_box) {
+                        cast.extend(c.added.iter().map(|&p| p - base).filter(near));
+                    }
+                    if meets(c.removed_box) {
+                        uncast.extend(c.removed.iter().map(|&p| p - base).filter(near));
+                    }
                 }
             }
             shadow.apply_nodes(uncast, -1);
