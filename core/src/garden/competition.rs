@@ -391,13 +391,14 @@ fn box_of(points: &[Vec3]) -> (Vec3, Vec3) {
 }
 
 impl NodeChanges {
-    /// The nodes of `t` that are not in `before` (its node ends before the iteration, garden
-    /// space) and those of `before` that are gone. Growth never moves a node and keeps the
-    /// survivors in arena order, so one walk matches them; should a survivor not match, every
-    /// old node counts as removed and every current one as added (the same sums).
-    pub(super) fn of(t: &GardenTree, before: &[Vec3]) -> NodeChanges {
+    /// The nodes of `t` that are not in `before` (its node ends, garden space, when it stood
+    /// at iteration `before_iteration`: before a round's iteration or an edit) and those of
+    /// `before` that are gone. A node born after `before_iteration` is new; growth never
+    /// moves a node and keeps the survivors in arena order, so one walk matches the others;
+    /// should one not match (a tree replaced, say by an undo), every old node counts as
+    /// removed and every current one as added (the same sums).
+    pub(super) fn of(t: &GardenTree, before: &[Vec3], before_iteration: u32) -> NodeChanges {
         let base = t.base();
-        let iteration = t.tree.iteration;
         let nodes = &t.tree.skeleton.internodes;
         let mut added = Vec::new();
         let mut added_in_tree = Vec::new();
@@ -406,7 +407,7 @@ impl NodeChanges {
         let mut matched = true;
         for n in nodes {
             let p = base + n.end;
-            if n.born_iteration == iteration {
+            if n.born_iteration > before_iteration {
                 added.push(p);
                 added_in_tree.push(n.end);
                 continue;
@@ -648,6 +649,47 @@ mod tests {
                 assert_eq!(height.to_bits(), tree_height_m(&t.tree).to_bits());
             }
         }
+    }
+
+    #[test]
+    fn the_changes_of_an_edit_of_several_iterations_are_its_new_and_shed_nodes_only() {
+        let species = crate::species::Species::by_name("birch").expect("preset");
+        let planted = vec![crate::garden::PlantedTree::new(species, 0.0, 0.0, 3.0, 1)];
+        let mut garden = Garden::plant(planted).expect("plants");
+        let t = &mut garden.trees[0];
+        let (before, k) = (node_ends(t), t.tree.iteration);
+        let unchanged = NodeChanges::of(t, &before, k);
+        assert!(unchanged.added.is_empty() && unchanged.removed.is_empty());
+        t.tree.grow(3, None);
+        let grown = NodeChanges::of(t, &before, k);
+        let born = t
+            .tree
+            .skeleton
+            .internodes
+            .iter()
+            .filter(|n| n.born_iteration > k)
+            .count();
+        assert!(born > 0);
+        assert_eq!(grown.added.len(), born);
+        assert_eq!(grown.added_in_tree.len(), born);
+        // What was shed in those iterations (the survivors all matched).
+        assert_eq!(
+            before.len() - grown.removed.len() + grown.added.len(),
+            t.tree.skeleton.len()
+        );
+        let mut left: Vec<[u32; 3]> = before
+            .iter()
+            .filter(|p| !grown.removed.contains(p))
+            .chain(&grown.added)
+            .map(|p| p.to_array().map(f32::to_bits))
+            .collect();
+        let mut now: Vec<[u32; 3]> = node_ends(t)
+            .iter()
+            .map(|p| p.to_array().map(f32::to_bits))
+            .collect();
+        left.sort_unstable();
+        now.sort_unstable();
+        assert_eq!(left, now);
     }
 
     #[test]
