@@ -197,7 +197,7 @@ fn box_dims(lo: IVec3, hi: IVec3) -> Option<IVec3> {
     let extent = |a: i32, b: i32| (i64::from(b) - i64::from(a) + 1).max(0);
     let (x, y, z) = (extent(lo.x, hi.x), extent(lo.y, hi.y), extent(lo.z, hi.z));
     let volume = x.checked_mul(y)?.checked_mul(z)?;
-    (volume > 0 && volume <= MAX_DENSE_BITS).then(|| IVec3::new(x as i32, y as i32, z as i32))
+    (volume > 0 && volume <= MAX_DENSE_BITS).then_some(IVec3::new(x as i32, y as i32, z as i32))
 }
 
 fn words_for(dims: IVec3) -> usize {

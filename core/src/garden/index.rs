@@ -56,7 +56,7 @@ fn dense_dims(lo: IVec3, hi: IVec3) -> Option<(usize, usize, usize)> {
     let (x, y, z) = (extent(lo.x, hi.x), extent(lo.y, hi.y), extent(lo.z, hi.z));
     let volume = x.checked_mul(y)?.checked_mul(z)?;
     (x > 0 && y > 0 && z > 0 && volume <= MAX_DENSE_CELLS)
-        .then(|| (x as usize, y as usize, z as usize))
+        .then_some((x as usize, y as usize, z as usize))
 }
 
 impl NodeIndex {
