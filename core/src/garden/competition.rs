@@ -535,8 +535,42 @@ pub(super) fn set_shade_everywhere(garden: &mut Garden, index: usize) {
         .filter(|&p| !t.shade_cover.covers(p))
         .collect();
     let t = &mut garden.trees[index];
-    t.tree.environment.shadow.apply_nodes(outside, 1);
+    apply_nodes_by_voxel(&mut t.tree.environment.shadow, outside, 1);
     t.shade_cover.everywhere = true;
+}
+
+/// The most nodes of one voxel cast as one pyramid of `sign` times their number: a level's Δs
+/// is at most 2^16 times a species' shadow strength (at most 10^3, its decay base above 1),
+/// so 32 of them stay within i32.
+const MAX_NODES_PER_CAST: usize = 32;
+
+/// [`crate::environment::ShadowGrid::apply_nodes`] of `nodes` (this grid's space) with
+/// `sign`, the same grid bit for bit, for a fraction of the pyramids: a node's pyramid is
+/// that of its voxel, so the n nodes sharing a voxel cast one pyramid of n times the sign
+/// (integer sums). Nodes that are not finite cast nothing, as in the grid.
+fn apply_nodes_by_voxel(shadow: &mut crate::environment::ShadowGrid, nodes: Vec<Vec3>, sign: i32) {
+    let size = shadow.voxel_size();
+    let mut keyed: Vec<(IVec3, Vec3)> = nodes
+        .into_iter()
+        .filter(|p| p.is_finite())
+        .map(|p| (floor_to_ivec3(p / size), p))
+        .collect();
+    keyed.sort_unstable_by_key(|&(v, _)| (v.x, v.y, v.z));
+    // by_count[n - 1]: one node of each voxel holding n of them (n up to the cap).
+    let mut by_count: Vec<Vec<Vec3>> = Vec::new();
+    for run in keyed.chunk_by(|a, b| a.0 == b.0) {
+        for part in run.chunks(MAX_NODES_PER_CAST) {
+            if by_count.len() < part.len() {
+                by_count.resize_with(part.len(), Vec::new);
+            }
+            by_count[part.len() - 1].push(part[0].1);
+        }
+    }
+    for (n, points) in (1..).zip(by_count) {
+        if !points.is_empty() {
+            shadow.apply_nodes(points, sign * n);
+        }
+    }
 }
 
 /// Each tree's shadow grid rebuilt from its own nodes and its linked neighbours' (those its
@@ -690,6 +724,79 @@ mod tests {
         left.sort_unstable();
         now.sort_unstable();
         assert_eq!(left, now);
+    }
+
+    #[test]
+    fn casting_by_voxel_makes_the_grid_of_casting_node_by_node() {
+        let mut by_node = crate::environment::ShadowGrid::new(0.1, 1.0, 1.5, 6);
+        let voxel = by_node.voxel_size();
+        let mut rng = crate::Rng::new(3);
+        // Many nodes sharing voxels (up to 80 in one, beyond one cast's cap), a few alone, and
+        // some that cast nothing (not finite, or beyond the grid's reach).
+        let mut nodes = Vec::new();
+        for k in 0..40 {
+            let centre = rng.in_unit_ball() * 2.0 + Vec3::Y * 3.0;
+            for _ in 0..(k * 2 + 1) {
+                nodes.push(centre + rng.in_unit_ball() * 0.3 * voxel);
+            }
+        }
+        nodes.extend([Vec3::NAN, Vec3::splat(f32::INFINITY), Vec3::X * 1e6]);
+        let mut by_voxel = by_node.clone();
+        by_node.apply_nodes(nodes.iter().copied(), 1);
+        apply_nodes_by_voxel(&mut by_voxel, nodes.clone(), 1);
+        assert_eq!(by_node.num_voxels(), by_voxel.num_voxels());
+        let mut sampled = 0;
+        for x in -40..40 {
+            for y in -10..70 {
+                for z in -40..40 {
+                    let p = (Vec3::new(x as f32, y as f32, z as f32) + 0.5) * voxel;
+                    let (a, b) = (by_node.shadow_at(p), by_voxel.shadow_at(p));
+                    assert_eq!(a.to_bits(), b.to_bits(), "at {p}");
+                    sampled += usize::from(a != 0.0);
+                }
+            }
+        }
+        assert!(sampled > 1000);
+        // Taken away the same way, nothing is left.
+        apply_nodes_by_voxel(&mut by_voxel, nodes, -1);
+        assert!(by_voxel.is_clear());
+    }
+
+    #[test]
+    fn a_first_edit_grows_as_with_every_neighbour_cast_node_by_node() {
+        let species = |name: &str| crate::species::Species::by_name(name).expect("preset");
+        let planted = vec![
+            crate::garden::PlantedTree::new(species("weeping_willow"), 0.0, 0.0, 0.0, 1),
+            crate::garden::PlantedTree::new(species("maple"), 1.6, 0.0, 0.0, 2),
+            crate::garden::PlantedTree::new(species("oak"), -1.4, 0.8, 0.0, 3),
+        ];
+        let mut garden = Garden::plant(planted).expect("plants");
+        garden.grow_years(6.0);
+        for edited in 0..3 {
+            let mut plain = garden.clone();
+            link_neighbours(&mut plain);
+            let t = &plain.trees[edited];
+            let base = t.base();
+            let outside: Vec<Vec3> = t
+                .neighbours
+                .iter()
+                .flat_map(|&j| node_ends(&plain.trees[j as usize]))
+                .map(|p| p - base)
+                .filter(|&p| !t.shade_cover.covers(p))
+                .collect();
+            assert!(!outside.is_empty());
+            let t = &mut plain.trees[edited];
+            t.tree.environment.shadow.apply_nodes(outside, 1);
+            t.shade_cover.everywhere = true;
+            plain.edit_tree(edited, dab_and_grow);
+            let mut voxels = garden.clone();
+            voxels.edit_tree(edited, dab_and_grow);
+            assert_eq!(
+                plain.trees[edited].tree.to_json_bytes().expect("saves"),
+                voxels.trees[edited].tree.to_json_bytes().expect("saves"),
+                "tree {edited} grew otherwise"
+            );
+        }
     }
 
     #[test]
