@@ -184,18 +184,18 @@ impl Garden {
         competition::index_nodes(self, &vec![false; self.trees.len()]);
         competition::gather_neighbour_nodes(self, due);
         competition::set_neighbour_tropisms(self, due);
-        let before: Vec<Option<Vec<Vec3>>> = self
+        let before: Vec<Option<(Vec<Vec3>, u32)>> = self
             .trees
             .par_iter()
             .zip(due)
-            .map(|(t, &d)| d.then(|| competition::node_ends(t)))
+            .map(|(t, &d)| d.then(|| (competition::node_ends(t), t.tree.iteration)))
             .collect();
         self.step_due(due, scenes);
         let changes: Vec<Option<competition::NodeChanges>> = self
             .trees
             .par_iter()
             .zip(before)
-            .map(|(t, before)| before.map(|b| competition::NodeChanges::of(t, &b)))
+            .map(|(t, before)| before.map(|(b, k)| competition::NodeChanges::of(t, &b, k)))
             .collect();
         competition::index_nodes(self, due);
         competition::hand_on_shade(self, &changes);
@@ -235,11 +235,16 @@ impl Garden {
         // neighbours' shade (cast once, at its first edit; see module `shade`).
         competition::set_shade_everywhere(self, index);
         let before = competition::node_ends(&self.trees[index]);
+        let before_iteration = self.trees[index].tree.iteration;
         edit(&mut self.trees[index].tree);
         self.trees[index].cache.changed();
         let mut changes: Vec<Option<competition::NodeChanges>> =
             (0..self.trees.len()).map(|_| None).collect();
-        changes[index] = Some(competition::NodeChanges::of(&self.trees[index], &before));
+        changes[index] = Some(competition::NodeChanges::of(
+            &self.trees[index],
+            &before,
+            before_iteration,
+        ));
         // Its grid takes every neighbour's shade already, so handing on asks no index: its
         // own is made anew at the next round.
         self.trees[index].node_index = index::NodeIndex::default();

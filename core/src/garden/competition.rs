@@ -21,7 +21,7 @@
 use glam::{IVec3, Vec2, Vec3};
 use rayon::prelude::*;
 
-use super::cell_hash::{self, cell_set_with_capacity};
+use super::cell_hash::CellBits;
 use super::index::{CellSet, NodeIndex};
 use super::shade::ShadeCover;
 use super::{Garden, GardenTree};
@@ -138,14 +138,15 @@ pub(super) fn link_neighbours(garden: &mut Garden) {
 
 /// Cells of `size` metres holding, or next to one holding, a place where tree `t` (its own
 /// space) can take attraction points this iteration: its nodes with a living bud and its
-/// persistent points.
-fn contact_cells(t: &GardenTree, size: f32) -> cell_hash::CellSet {
+/// persistent points. Returns the cells that hold such a place (each once) and the set of
+/// those cells each with the 26 around it, so that a neighbour's node needs one look-up.
+fn contact_cells(t: &GardenTree, size: f32) -> (Vec<IVec3>, CellBits) {
     let cell = |p: Vec3| (p / size).floor().as_ivec3();
     let tree = &t.tree;
     let buds = tree.skeleton.internodes.iter().filter(|n| {
         n.terminal_bud.as_ref().is_some_and(|b| b.alive) || n.lateral_buds.iter().any(|b| b.alive)
     });
-    let own: cell_hash::CellSet = buds
+    let places: Vec<IVec3> = buds
         .map(|n| cell(n.end))
         .chain(
             tree.environment
@@ -155,18 +156,28 @@ fn contact_cells(t: &GardenTree, size: f32) -> cell_hash::CellSet {
                 .map(|p| cell(p.position)),
         )
         .collect();
-    // Each cell with the 26 around it, so that a neighbour's node needs one look-up.
-    let mut cells = cell_set_with_capacity(own.len() * 4);
-    for c in own {
+    let (lo, hi) = places.iter().fold(
+        (IVec3::splat(i32::MAX), IVec3::splat(i32::MIN)),
+        |(lo, hi), &c| (lo.min(c), hi.max(c)),
+    );
+    let mut own = CellBits::with_box(lo, hi);
+    let mut cells =
+        CellBits::with_box(lo.saturating_sub(IVec3::ONE), hi.saturating_add(IVec3::ONE));
+    let mut each = Vec::new();
+    for c in places {
+        if !own.insert(c) {
+            continue;
+        }
+        each.push(c);
         for dx in -1..=1 {
             for dy in -1..=1 {
                 for dz in -1..=1 {
-                    cells.insert(c + IVec3::new(dx, dy, dz));
+                    cells.insert(c.saturating_add(IVec3::new(dx, dy, dz)));
                 }
             }
         }
     }
-    cells
+    (each, cells)
 }
 
 /// Gives every tree that is `due` the nodes of its linked neighbours that can take an
@@ -187,14 +198,15 @@ pub(super) fn gather_neighbour_nodes(garden: &mut Garden, due: &[bool]) {
             let size = (2.0 * s.occupancy_radius_internodes + s.perception_distance_internodes)
                 * s.internode_length_m
                 + REACH_SLACK_M;
-            let cells = contact_cells(t, size);
+            let (places, cells) = contact_cells(t, size);
             let base = t.base();
-            let (mut lo, mut hi) = (IVec3::splat(i32::MAX), IVec3::splat(i32::MIN));
+            // The index cells the 27 cells around each place touch (a superset of those
+            // holding a node in `cells`: each node is tested below).
             let mut asked = CellSet::default();
-            for &c in &cells {
-                (lo, hi) = (lo.min(c), hi.max(c));
-                let corner = c.as_vec3() * size;
-                asked.add_box(base + corner, base + corner + Vec3::splat(size));
+            for c in places {
+                let lo = c.saturating_sub(IVec3::ONE).as_vec3();
+                let hi = c.saturating_add(IVec3::splat(2)).as_vec3();
+                asked.add_box(base + lo * size, base + hi * size);
             }
             let mut nodes = Vec::new();
             for &j in &t.neighbours {
@@ -202,8 +214,7 @@ pub(super) fn gather_neighbour_nodes(garden: &mut Garden, due: &[bool]) {
                 let offset = n.base() - base;
                 n.node_index.for_each_in(&asked, |end| {
                     let p = end + offset;
-                    let c = floor_to_ivec3(p / size);
-                    if c.cmpge(lo).all() && c.cmple(hi).all() && cells.contains(&c) {
+                    if cells.contains(floor_to_ivec3(p / size)) {
                         nodes.push(p);
                     }
                 });
@@ -363,16 +374,31 @@ pub(super) struct NodeChanges {
     removed: Vec<Vec3>,
     /// The added nodes in the tree's own space (as its grid reads them).
     added_in_tree: Vec<Vec3>,
+    /// The boxes of `added` and of `removed` (lo above hi when empty).
+    added_box: (Vec3, Vec3),
+    removed_box: (Vec3, Vec3),
+}
+
+/// The box of the finite `points` (lo above hi when there are none; a point that is not
+/// finite casts no shade, so it takes no part).
+fn box_of(points: &[Vec3]) -> (Vec3, Vec3) {
+    points
+        .iter()
+        .filter(|p| p.is_finite())
+        .fold((Vec3::INFINITY, Vec3::NEG_INFINITY), |(lo, hi), &p| {
+            (lo.min(p), hi.max(p))
+        })
 }
 
 impl NodeChanges {
-    /// The nodes of `t` that are not in `before` (its node ends before the iteration, garden
-    /// space) and those of `before` that are gone. Growth never moves a node and keeps the
-    /// survivors in arena order, so one walk matches them; should a survivor not match, every
-    /// old node counts as removed and every current one as added (the same sums).
-    pub(super) fn of(t: &GardenTree, before: &[Vec3]) -> NodeChanges {
+    /// The nodes of `t` that are not in `before` (its node ends, garden space, when it stood
+    /// at iteration `before_iteration`: before a round's iteration or an edit) and those of
+    /// `before` that are gone. A node born after `before_iteration` is new; growth never
+    /// moves a node and keeps the survivors in arena order, so one walk matches the others;
+    /// should one not match (a tree replaced, say by an undo), every old node counts as
+    /// removed and every current one as added (the same sums).
+    pub(super) fn of(t: &GardenTree, before: &[Vec3], before_iteration: u32) -> NodeChanges {
         let base = t.base();
-        let iteration = t.tree.iteration;
         let nodes = &t.tree.skeleton.internodes;
         let mut added = Vec::new();
         let mut added_in_tree = Vec::new();
@@ -381,7 +407,7 @@ impl NodeChanges {
         let mut matched = true;
         for n in nodes {
             let p = base + n.end;
-            if n.born_iteration == iteration {
+            if n.born_iteration > before_iteration {
                 added.push(p);
                 added_in_tree.push(n.end);
                 continue;
@@ -401,14 +427,17 @@ impl NodeChanges {
             }
         }
         if !matched {
-            return NodeChanges {
-                added: nodes.iter().map(|n| base + n.end).collect(),
-                removed: before.to_vec(),
-                added_in_tree: nodes.iter().map(|n| n.end).collect(),
-            };
+            (added, removed, added_in_tree) = (
+                nodes.iter().map(|n| base + n.end).collect(),
+                before.to_vec(),
+                nodes.iter().map(|n| n.end).collect(),
+            );
+        } else {
+            removed.extend(old.copied());
         }
-        removed.extend(old.copied());
         NodeChanges {
+            added_box: box_of(&added),
+            removed_box: box_of(&removed),
             added,
             removed,
             added_in_tree,
@@ -452,8 +481,13 @@ pub(super) fn hand_on_shade(garden: &mut Garden, changes: &[Option<NodeChanges>]
             for &j in &t.neighbours {
                 if let Some(c) = &changes[j as usize] {
                     let near = |p: &Vec3| cover.covers(*p);
-                    cast.extend(c.added.iter().map(|&p| p - base).filter(near));
-                    uncast.extend(c.removed.iter().map(|&p| p - base).filter(near));
+                    let meets = |(lo, hi): (Vec3, Vec3)| cover.may_cover_box(lo - base, hi - base);
+                    if meets(c.added_box) {
+                        cast.extend(c.added.iter().map(|&p| p - base).filter(near));
+                    }
+                    if meets(c.removed_box) {
+                        uncast.extend(c.removed.iter().map(|&p| p - base).filter(near));
+                    }
                 }
             }
             shadow.apply_nodes(uncast, -1);
@@ -501,8 +535,42 @@ pub(super) fn set_shade_everywhere(garden: &mut Garden, index: usize) {
         .filter(|&p| !t.shade_cover.covers(p))
         .collect();
     let t = &mut garden.trees[index];
-    t.tree.environment.shadow.apply_nodes(outside, 1);
+    apply_nodes_by_voxel(&mut t.tree.environment.shadow, outside, 1);
     t.shade_cover.everywhere = true;
+}
+
+/// The most nodes of one voxel cast as one pyramid of `sign` times their number: a level's Δs
+/// is at most 2^16 times a species' shadow strength (at most 10^3, its decay base above 1),
+/// so 32 of them stay within i32.
+const MAX_NODES_PER_CAST: usize = 32;
+
+/// [`crate::environment::ShadowGrid::apply_nodes`] of `nodes` (this grid's space) with
+/// `sign`, the same grid bit for bit, for a fraction of the pyramids: a node's pyramid is
+/// that of its voxel, so the n nodes sharing a voxel cast one pyramid of n times the sign
+/// (integer sums). Nodes that are not finite cast nothing, as in the grid.
+fn apply_nodes_by_voxel(shadow: &mut crate::environment::ShadowGrid, nodes: Vec<Vec3>, sign: i32) {
+    let size = shadow.voxel_size();
+    let mut keyed: Vec<(IVec3, Vec3)> = nodes
+        .into_iter()
+        .filter(|p| p.is_finite())
+        .map(|p| (floor_to_ivec3(p / size), p))
+        .collect();
+    keyed.sort_unstable_by_key(|&(v, _)| (v.x, v.y, v.z));
+    // by_count[n - 1]: one node of each voxel holding n of them (n up to the cap).
+    let mut by_count: Vec<Vec<Vec3>> = Vec::new();
+    for run in keyed.chunk_by(|a, b| a.0 == b.0) {
+        for part in run.chunks(MAX_NODES_PER_CAST) {
+            if by_count.len() < part.len() {
+                by_count.resize_with(part.len(), Vec::new);
+            }
+            by_count[part.len() - 1].push(part[0].1);
+        }
+    }
+    for (n, points) in (1..).zip(by_count) {
+        if !points.is_empty() {
+            shadow.apply_nodes(points, sign * n);
+        }
+    }
 }
 
 /// Each tree's shadow grid rebuilt from its own nodes and its linked neighbours' (those its
@@ -614,6 +682,120 @@ mod tests {
                 let height = t.tree.metrics().height_m;
                 assert_eq!(height.to_bits(), tree_height_m(&t.tree).to_bits());
             }
+        }
+    }
+
+    #[test]
+    fn the_changes_of_an_edit_of_several_iterations_are_its_new_and_shed_nodes_only() {
+        let species = crate::species::Species::by_name("birch").expect("preset");
+        let planted = vec![crate::garden::PlantedTree::new(species, 0.0, 0.0, 3.0, 1)];
+        let mut garden = Garden::plant(planted).expect("plants");
+        let t = &mut garden.trees[0];
+        let (before, k) = (node_ends(t), t.tree.iteration);
+        let unchanged = NodeChanges::of(t, &before, k);
+        assert!(unchanged.added.is_empty() && unchanged.removed.is_empty());
+        t.tree.grow(3, None);
+        let grown = NodeChanges::of(t, &before, k);
+        let born = t
+            .tree
+            .skeleton
+            .internodes
+            .iter()
+            .filter(|n| n.born_iteration > k)
+            .count();
+        assert!(born > 0);
+        assert_eq!(grown.added.len(), born);
+        assert_eq!(grown.added_in_tree.len(), born);
+        // What was shed in those iterations (the survivors all matched).
+        assert_eq!(
+            before.len() - grown.removed.len() + grown.added.len(),
+            t.tree.skeleton.len()
+        );
+        let mut left: Vec<[u32; 3]> = before
+            .iter()
+            .filter(|p| !grown.removed.contains(p))
+            .chain(&grown.added)
+            .map(|p| p.to_array().map(f32::to_bits))
+            .collect();
+        let mut now: Vec<[u32; 3]> = node_ends(t)
+            .iter()
+            .map(|p| p.to_array().map(f32::to_bits))
+            .collect();
+        left.sort_unstable();
+        now.sort_unstable();
+        assert_eq!(left, now);
+    }
+
+    #[test]
+    fn casting_by_voxel_makes_the_grid_of_casting_node_by_node() {
+        let mut by_node = crate::environment::ShadowGrid::new(0.1, 1.0, 1.5, 6);
+        let voxel = by_node.voxel_size();
+        let mut rng = crate::Rng::new(3);
+        // Many nodes sharing voxels (up to 80 in one, beyond one cast's cap), a few alone, and
+        // some that cast nothing (not finite, or beyond the grid's reach).
+        let mut nodes = Vec::new();
+        for k in 0..40 {
+            let centre = rng.in_unit_ball() * 2.0 + Vec3::Y * 3.0;
+            for _ in 0..(k * 2 + 1) {
+                nodes.push(centre + rng.in_unit_ball() * 0.3 * voxel);
+            }
+        }
+        nodes.extend([Vec3::NAN, Vec3::splat(f32::INFINITY), Vec3::X * 1e6]);
+        let mut by_voxel = by_node.clone();
+        by_node.apply_nodes(nodes.iter().copied(), 1);
+        apply_nodes_by_voxel(&mut by_voxel, nodes.clone(), 1);
+        assert_eq!(by_node.num_voxels(), by_voxel.num_voxels());
+        let mut sampled = 0;
+        for x in -40..40 {
+            for y in -10..70 {
+                for z in -40..40 {
+                    let p = (Vec3::new(x as f32, y as f32, z as f32) + 0.5) * voxel;
+                    let (a, b) = (by_node.shadow_at(p), by_voxel.shadow_at(p));
+                    assert_eq!(a.to_bits(), b.to_bits(), "at {p}");
+                    sampled += usize::from(a != 0.0);
+                }
+            }
+        }
+        assert!(sampled > 1000);
+        // Taken away the same way, nothing is left.
+        apply_nodes_by_voxel(&mut by_voxel, nodes, -1);
+        assert!(by_voxel.is_clear());
+    }
+
+    #[test]
+    fn a_first_edit_grows_as_with_every_neighbour_cast_node_by_node() {
+        let species = |name: &str| crate::species::Species::by_name(name).expect("preset");
+        let planted = vec![
+            crate::garden::PlantedTree::new(species("weeping_willow"), 0.0, 0.0, 0.0, 1),
+            crate::garden::PlantedTree::new(species("maple"), 1.6, 0.0, 0.0, 2),
+            crate::garden::PlantedTree::new(species("oak"), -1.4, 0.8, 0.0, 3),
+        ];
+        let mut garden = Garden::plant(planted).expect("plants");
+        garden.grow_years(6.0);
+        for edited in 0..3 {
+            let mut plain = garden.clone();
+            link_neighbours(&mut plain);
+            let t = &plain.trees[edited];
+            let base = t.base();
+            let outside: Vec<Vec3> = t
+                .neighbours
+                .iter()
+                .flat_map(|&j| node_ends(&plain.trees[j as usize]))
+                .map(|p| p - base)
+                .filter(|&p| !t.shade_cover.covers(p))
+                .collect();
+            assert!(!outside.is_empty());
+            let t = &mut plain.trees[edited];
+            t.tree.environment.shadow.apply_nodes(outside, 1);
+            t.shade_cover.everywhere = true;
+            plain.edit_tree(edited, dab_and_grow);
+            let mut voxels = garden.clone();
+            voxels.edit_tree(edited, dab_and_grow);
+            assert_eq!(
+                plain.trees[edited].tree.to_json_bytes().expect("saves"),
+                voxels.trees[edited].tree.to_json_bytes().expect("saves"),
+                "tree {edited} grew otherwise"
+            );
         }
     }
 

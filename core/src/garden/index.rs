@@ -14,12 +14,22 @@ const INDEX_CELL_M: f32 = 1.0;
 /// position and the same node seen from another tree.
 const BOX_SLACK_M: f32 = 1e-3;
 
-/// A tree's node ends (its own space) sorted by the index cell of their garden position.
+/// The most index cells a dense index spans (4 MiB of starts); a larger box (the far nodes of
+/// a damaged tree) is indexed by sorted cells instead.
+const MAX_DENSE_CELLS: i64 = 1 << 20;
+
+/// A tree's node ends (its own space) grouped by the index cell of their garden position.
 #[derive(Clone, Debug, Default)]
 pub(crate) struct NodeIndex {
     /// Whether it holds the tree's current nodes.
     pub(super) built: bool,
-    /// Index cells that hold nodes, in sorted order, with where their nodes start in `ends`.
+    /// The box of the cells that hold nodes (lo above hi when none).
+    lo: IVec3,
+    hi: IVec3,
+    /// Dense: for every cell of the box (x fastest, then y, then z), where its nodes start in
+    /// `ends` (one more entry at the end). Empty when the index is sparse.
+    starts: Vec<u32>,
+    /// Sparse: the cells that hold nodes, in sorted order, with where their nodes start.
     cells: Vec<(IVec3, u32)>,
     ends: Vec<Vec3>,
 }
@@ -40,10 +50,54 @@ fn index_cell(point: Vec3) -> IVec3 {
     floor_to_ivec3(point / INDEX_CELL_M)
 }
 
+/// The cells along each axis of the box `lo..=hi` if it holds at most [`MAX_DENSE_CELLS`].
+fn dense_dims(lo: IVec3, hi: IVec3) -> Option<(usize, usize, usize)> {
+    let extent = |a: i32, b: i32| i64::from(b) - i64::from(a) + 1;
+    let (x, y, z) = (extent(lo.x, hi.x), extent(lo.y, hi.y), extent(lo.z, hi.z));
+    let volume = x.checked_mul(y)?.checked_mul(z)?;
+    (x > 0 && y > 0 && z > 0 && volume <= MAX_DENSE_CELLS)
+        .then_some((x as usize, y as usize, z as usize))
+}
+
 impl NodeIndex {
     /// The index of nodes `ends` (tree space) of a tree whose base is at `base` (garden space).
     pub(super) fn of(base: Vec3, ends: impl Iterator<Item = Vec3>) -> NodeIndex {
-        let mut keyed: Vec<(IVec3, Vec3)> = ends.map(|e| (index_cell(base + e), e)).collect();
+        let keyed: Vec<(IVec3, Vec3)> = ends.map(|e| (index_cell(base + e), e)).collect();
+        let (lo, hi) = keyed
+            .iter()
+            .fold((IVec3::MAX, IVec3::MIN), |(lo, hi), &(c, _)| {
+                (lo.min(c), hi.max(c))
+            });
+        if let Some((dx, dy, dz)) = dense_dims(lo, hi) {
+            // A counting sort by dense cell.
+            let slot = |c: IVec3| {
+                let o = (c - lo).as_uvec3();
+                o.x as usize + dx * (o.y as usize + dy * o.z as usize)
+            };
+            let mut starts = vec![0u32; dx * dy * dz + 1];
+            for &(c, _) in &keyed {
+                starts[slot(c) + 1] += 1;
+            }
+            for k in 1..starts.len() {
+                starts[k] += starts[k - 1];
+            }
+            let mut next = starts.clone();
+            let mut ends = vec![Vec3::ZERO; keyed.len()];
+            for &(c, e) in &keyed {
+                let k = &mut next[slot(c)];
+                ends[*k as usize] = e;
+                *k += 1;
+            }
+            return NodeIndex {
+                built: true,
+                lo,
+                hi,
+                starts,
+                cells: Vec::new(),
+                ends,
+            };
+        }
+        let mut keyed = keyed;
         keyed.sort_unstable_by_key(|&(c, _)| cell_key(c));
         let mut cells: Vec<(IVec3, u32)> = Vec::new();
         for (k, &(c, _)) in keyed.iter().enumerate() {
@@ -53,6 +107,9 @@ impl NodeIndex {
         }
         NodeIndex {
             built: true,
+            lo,
+            hi,
+            starts: Vec::new(),
             cells,
             ends: keyed.into_iter().map(|(_, e)| e).collect(),
         }
@@ -60,6 +117,15 @@ impl NodeIndex {
 
     /// The node ends (tree space) whose garden position lies in index cell `c`.
     fn in_cell(&self, c: IVec3) -> &[Vec3] {
+        if c.cmplt(self.lo).any() || c.cmpgt(self.hi).any() {
+            return &[];
+        }
+        if !self.starts.is_empty() {
+            let d = (self.hi - self.lo + IVec3::ONE).as_uvec3();
+            let o = (c - self.lo).as_uvec3();
+            let k = o.x as usize + d.x as usize * (o.y as usize + d.y as usize * o.z as usize);
+            return &self.ends[self.starts[k] as usize..self.starts[k + 1] as usize];
+        }
         let key = cell_key(c);
         match self.cells.binary_search_by_key(&key, |&(c, _)| cell_key(c)) {
             Ok(k) => {
@@ -76,7 +142,7 @@ impl NodeIndex {
 
     /// Calls `f` with every node end (tree space) in one of `cells`.
     pub(super) fn for_each_in(&self, cells: &CellSet, mut f: impl FnMut(Vec3)) {
-        if self.cells.is_empty() {
+        if self.ends.is_empty() || cells.lo.cmpgt(self.hi).any() || cells.hi.cmplt(self.lo).any() {
             return;
         }
         for &c in &cells.cells {
@@ -88,10 +154,23 @@ impl NodeIndex {
 }
 
 /// Index cells asked for: those touched by a set of boxes (garden space).
-#[derive(Default)]
 pub(super) struct CellSet {
     seen: cell_hash::CellSet,
     cells: Vec<IVec3>,
+    /// The box of `cells` (lo above hi when none).
+    lo: IVec3,
+    hi: IVec3,
+}
+
+impl Default for CellSet {
+    fn default() -> CellSet {
+        CellSet {
+            seen: cell_hash::CellSet::default(),
+            cells: Vec::new(),
+            lo: IVec3::MAX,
+            hi: IVec3::MIN,
+        }
+    }
 }
 
 impl CellSet {
@@ -107,6 +186,8 @@ impl CellSet {
                     let c = IVec3::new(x, y, z);
                     if self.seen.insert(c) {
                         self.cells.push(c);
+                        self.lo = self.lo.min(c);
+                        self.hi = self.hi.max(c);
                     }
                 }
             }
@@ -135,5 +216,39 @@ mod tests {
         index.for_each_in(&asked, |e| found.push(e));
         found.sort_by(|a, b| a.x.total_cmp(&b.x));
         assert_eq!(found, vec![ends[0], ends[2]]);
+        // A box far from every node finds none; one over all of them finds each once.
+        let mut far = CellSet::default();
+        far.add_box(base + Vec3::splat(40.0), base + Vec3::splat(41.0));
+        let mut none = 0;
+        index.for_each_in(&far, |_| none += 1);
+        assert_eq!(none, 0);
+        let mut all = CellSet::default();
+        all.add_box(base - Vec3::splat(2.0), base + Vec3::splat(4.0));
+        let mut found = Vec::new();
+        index.for_each_in(&all, |e| found.push(e));
+        found.sort_by(|a, b| a.x.total_cmp(&b.x));
+        let mut expected = ends.to_vec();
+        expected.sort_by(|a, b| a.x.total_cmp(&b.x));
+        assert_eq!(found, expected);
+    }
+
+    #[test]
+    fn a_sparse_index_of_far_apart_nodes_finds_the_same_as_a_dense_one() {
+        let base = Vec3::ZERO;
+        let near = [Vec3::new(0.2, 0.3, 0.4), Vec3::new(1.5, 0.5, -0.5)];
+        let mut ends = near.to_vec();
+        ends.push(Vec3::new(400.0, 300.0, -400.0));
+        let sparse = NodeIndex::of(base, ends.iter().copied());
+        let dense = NodeIndex::of(base, near.iter().copied());
+        assert!(sparse.starts.is_empty() && !dense.starts.is_empty());
+        let mut asked = CellSet::default();
+        asked.add_box(Vec3::splat(-1.0), Vec3::splat(2.0));
+        let (mut a, mut b) = (Vec::new(), Vec::new());
+        sparse.for_each_in(&asked, |e| a.push(e));
+        dense.for_each_in(&asked, |e| b.push(e));
+        a.sort_by(|p, q| p.x.total_cmp(&q.x));
+        b.sort_by(|p, q| p.x.total_cmp(&q.x));
+        assert_eq!(a, b);
+        assert_eq!(a.len(), 2);
     }
 }

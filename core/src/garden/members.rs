@@ -142,6 +142,7 @@ impl Garden {
             return false;
         }
         let before = node_ends(&self.trees[index]);
+        let before_iteration = self.trees[index].tree.iteration;
         self.trees[index].tree = tree;
         self.trees[index].cache.changed();
         if !self.competition {
@@ -164,7 +165,11 @@ impl Garden {
         }
         t.shade_cover.everywhere = true;
         let mut changes: Vec<Option<NodeChanges>> = (0..self.trees.len()).map(|_| None).collect();
-        changes[index] = Some(NodeChanges::of(&self.trees[index], &before));
+        changes[index] = Some(NodeChanges::of(
+            &self.trees[index],
+            &before,
+            before_iteration,
+        ));
         self.trees[index].node_index = index::NodeIndex::default();
         competition::hand_on_shade(self, &changes);
         true
