@@ -133,6 +133,8 @@ pub(crate) struct Scratch {
     pub size: Vec<u32>,
     pub in_mask: Vec<bool>,
     pub acc: Vec<f64>,
+    /// What `acc` holds the sums of, when they describe the arena ([`widths`]).
+    pub widths_of: Option<widths::WidthsOf>,
     pub subtree_root: Vec<u32>,
     /// The arena's links as bud collection reads them, compact for the passes that follow
     /// before the arena changes (both vigor passes, shedding): main child of node i
@@ -141,6 +143,10 @@ pub(crate) struct Scratch {
     pub main_child: Vec<u32>,
     pub lateral_range: Vec<(u32, u32)>,
     pub lateral: Vec<u32>,
+    /// Nodes on the paths from the enabled buds to the base, and a flag per node ([`vigor`]'s
+    /// pass along those paths).
+    pub on_path: Vec<bool>,
+    pub path_nodes: Vec<u32>,
     /// Every node born before this iteration had all its lateral buds dead at the start of
     /// iteration `expired_at` ([`buds::collect`] kills them once they outlive the bud lifetime).
     pub expired_below: u32,
@@ -302,7 +308,7 @@ impl Tree {
         clock.lap(timing::Phase::Space);
         stats.num_enabled_buds = light::bud_input(self, &mut scratch);
         clock.lap(timing::Phase::BudInput);
-        let v_max = vigor::distribute(self, &mut scratch);
+        let v_max = vigor::distribute(self, &mut scratch, options.autonomous);
         stats.num_buds = scratch.buds.len();
         let shed = if options.autonomous && v_max > 0.0 {
             vigor::select_shed(self, &mut scratch, v_max)
@@ -311,6 +317,7 @@ impl Tree {
         };
         let removed = subtree_flags(&scratch, &shed);
         clock.lap(timing::Phase::Vigor);
+        let num_before = self.skeleton.len();
         let grown = shoots::grow_all(self, &mut scratch, v_max, &removed, options.scene);
         stats.num_shoots = grown.0;
         stats.num_new_internodes = grown.1;
@@ -327,8 +334,23 @@ impl Tree {
         clock.lap(timing::Phase::Shed);
         space::finish_iteration(self, &scratch);
         clock.lap(timing::Phase::Finish);
-        self.scratch = scratch;
-        self.update_widths();
+        // When internodes were only added, the widths change along their paths to the base.
+        let only_added = stats.num_shed_internodes == 0 && stats.num_pruned_internodes == 0;
+        if !(only_added
+            && widths::update_after_growth(
+                &mut self.skeleton,
+                self.species.tip_diameter_m,
+                self.species.pipe_exponent,
+                &mut self.pipe_exponents,
+                &mut scratch,
+                num_before,
+            ))
+        {
+            self.scratch = scratch;
+            self.update_widths();
+        } else {
+            self.scratch = scratch;
+        }
         clock.lap(timing::Phase::Widths);
         stats
     }
