@@ -151,6 +151,9 @@ pub(crate) struct Scratch {
     /// iteration `expired_at` ([`buds::collect`] kills them once they outlive the bud lifetime).
     pub expired_below: u32,
     pub expired_at: Option<u32>,
+    /// What the last bud collection computed the nodes' light exposures from
+    /// ([`buds::collect`] keeps those whose shadow cannot have changed since).
+    pub light_seen: Option<buds::LightSeen>,
     /// The autonomous points of each block of buds, and the generator's draws before each
     /// block (the parallel point generation, [`space`]).
     pub point_blocks: Vec<Vec<crate::environment::AttractionPoint>>,

@@ -93,6 +93,25 @@ pub(crate) fn collect(tree: &mut Tree, scratch: &mut Scratch) {
     }
     let (species, shadow) = (&tree.species, &tree.environment.shadow);
     let light_matters = species.light_sensitivity > 0.0;
+    // A node that had living buds at the previous iteration's collection got its exposure
+    // then; if the grid is the same one and no change since touched the node's brick, the
+    // same formula would give the same value, so it is kept. New nodes (born since, with the
+    // exposure their shoot gave them) and every node after anything else (a clone, a loaded
+    // tree, another grid, other light parameters) get it computed.
+    let light_key = LightKey {
+        grid: shadow.id(),
+        full_exposure: species.full_exposure.to_bits(),
+        shadow_strength: species.shadow_strength.to_bits(),
+    };
+    let light_seen = scratch
+        .light_seen
+        .filter(|seen| seen.key == light_key && seen.iteration + 1 == tree.iteration)
+        .map(|seen| (seen.version, seen.iteration));
+    scratch.light_seen = Some(LightSeen {
+        key: light_key,
+        version: shadow.version(),
+        iteration: tree.iteration,
+    });
     let Scratch {
         buds,
         node_bud_start,
@@ -127,7 +146,12 @@ pub(crate) fn collect(tree: &mut Tree, scratch: &mut Scratch) {
                 } else {
                     node.lateral_buds.iter().filter(|b| b.alive).count() as u32
                 };
-                if terminal || laterals > 0 {
+                let current = || {
+                    light_seen.is_some_and(|(version, iteration)| {
+                        node.born_iteration < iteration && !shadow.changed_since(node.end, version)
+                    })
+                };
+                if (terminal || laterals > 0) && !current() {
                     node.light_exposure = super::light::exposure(species, shadow, node.end);
                 }
                 num_buds += u32::from(terminal) + laterals;
@@ -231,6 +255,23 @@ pub(crate) fn collect(tree: &mut Tree, scratch: &mut Scratch) {
     let num_buds = scratch.buds.len();
     clear_with_room(&mut scratch.won, num_buds);
     scratch.won.resize(num_buds, WonPoints::default());
+}
+
+/// What the light exposures of [`collect`] were computed from: the shadow grid and the
+/// species' light parameters (bits).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct LightKey {
+    grid: u64,
+    full_exposure: u32,
+    shadow_strength: u32,
+}
+
+/// The last [`collect`]: its light key, the grid's version then and the iteration.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LightSeen {
+    key: LightKey,
+    version: u64,
+    iteration: u32,
 }
 
 impl BudState {
