@@ -159,7 +159,7 @@ pub(crate) struct Scratch {
     pub point_blocks: Vec<Vec<crate::environment::AttractionPoint>>,
     pub point_block_draws: Vec<u64>,
     /// Living buds and lateral children of each block of nodes ([`buds::collect`]).
-    pub block_counts: Vec<(u32, u32)>,
+    pub bud_blocks: Vec<buds::BudBlock>,
 }
 
 /// No part of a tree lies further than this from its base (metres): beyond any real tree, a
@@ -597,5 +597,84 @@ impl PartialEq for Tree {
             && self.environment.attraction == other.environment.attraction
             && self.growth_mask == other.growth_mask
             && self.rng == other.rng
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+
+    /// Steps `tree` (keeping its working memory) and a clone of it made before every step
+    /// (empty working memory: every pass over the whole tree) and checks they stay equal,
+    /// widths and light exposures included.
+    fn step_both(kept: &mut Tree, options: StepOptions, what: &str) {
+        let mut fresh = kept.clone();
+        kept.step(options);
+        fresh.step(options);
+        assert!(*kept == fresh, "{what}");
+        for (i, (a, b)) in kept
+            .skeleton
+            .internodes
+            .iter()
+            .zip(&fresh.skeleton.internodes)
+            .enumerate()
+        {
+            assert_eq!(
+                a.diameter.to_bits(),
+                b.diameter.to_bits(),
+                "{what}: node {i}"
+            );
+            assert_eq!(
+                a.light_exposure.to_bits(),
+                b.light_exposure.to_bits(),
+                "{what}: node {i}"
+            );
+        }
+    }
+
+    #[test]
+    fn kept_sums_and_exposures_grow_the_same_tree_as_passes_over_the_whole_tree() {
+        let species = Species::by_name("maple").expect("maple preset");
+        let mut tree = Tree::new(species, 9);
+        let autonomous = StepOptions {
+            autonomous: true,
+            scene: None,
+        };
+        let brushed = StepOptions {
+            autonomous: false,
+            scene: None,
+        };
+        for i in 0..6 {
+            step_both(&mut tree, autonomous, &format!("autonomous {i}"));
+        }
+        let mut rng = crate::rng::Rng::new(3);
+        let brushed_from = tree.skeleton.len();
+        for i in 0..8 {
+            let top = Vec3::new(0.2, tree.metrics().height_m + 0.1, 0.1);
+            for _ in 0..80 {
+                tree.environment
+                    .attraction
+                    .add_persistent(top + rng.in_unit_ball() * 0.3);
+            }
+            if i == 3 {
+                // Other light parameters: every exposure is computed again.
+                tree.species.shadow_strength *= 1.5;
+            }
+            if i == 5 {
+                // Shade from outside growth (a garden's neighbours).
+                tree.environment
+                    .shadow
+                    .apply_nodes([top - Vec3::Y * 0.5, top + Vec3::X * 0.2], 1);
+            }
+            step_both(&mut tree, brushed, &format!("brushed {i}"));
+        }
+        assert!(
+            tree.skeleton.len() > brushed_from && brushed_from > 300,
+            "{brushed_from} → {}",
+            tree.skeleton.len()
+        );
+        step_both(&mut tree, autonomous, "autonomous after brushing");
     }
 }

@@ -261,3 +261,57 @@ pub(crate) fn select_shed(tree: &Tree, scratch: &mut Scratch, v_max: f32) -> Vec
         .map(|c| NodeId(c as u32))
         .collect()
 }
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+    use crate::growth::{StepOptions, buds, light, space, timing};
+    use crate::species::Species;
+
+    #[test]
+    fn the_pass_along_the_enabled_buds_paths_gives_every_bud_the_vigor_of_the_whole_pass() {
+        let species = Species::by_name("maple").expect("maple preset");
+        let mut tree = Tree::new(species, 4);
+        tree.grow(8, None);
+        // A brush dab beside the crown: a few buds near it win points.
+        let top = Vec3::new(0.3, tree.metrics().height_m * 0.8, 0.0);
+        let mut rng = crate::rng::Rng::new(2);
+        for _ in 0..60 {
+            tree.environment
+                .attraction
+                .add_persistent(top + rng.in_unit_ball() * 0.3);
+        }
+        tree.iteration += 1;
+        let mut scratch = Scratch::default();
+        let options = StepOptions {
+            autonomous: false,
+            scene: None,
+        };
+        buds::collect(&mut tree, &mut scratch);
+        let mut clock = timing::PhaseClock::start();
+        space::colonize(&mut tree, &mut scratch, options, &mut clock);
+        let enabled = light::bud_input(&tree, &mut scratch);
+        assert!(enabled > 0, "no bud enabled");
+        assert!(
+            enabled * PATH_PASS_BUDS_PER_NODE <= tree.skeleton.len(),
+            "{enabled} enabled of {} nodes",
+            tree.skeleton.len()
+        );
+        let mut along = scratch.buds.clone();
+        let v_along = distribute_along_paths(&tree, &mut scratch).expect("the paths pass runs");
+        std::mem::swap(&mut along, &mut scratch.buds);
+        let v_all = distribute(&tree, &mut scratch, true);
+        assert_eq!(v_along.to_bits(), v_all.to_bits());
+        assert!(v_all > 0.0);
+        for (a, b) in along.iter().zip(&scratch.buds) {
+            assert_eq!(
+                a.vigor.to_bits(),
+                b.vigor.to_bits(),
+                "bud of node {}",
+                a.node
+            );
+        }
+    }
+}
