@@ -652,11 +652,19 @@ mod tests {
         let mut rng = crate::rng::Rng::new(3);
         let brushed_from = tree.skeleton.len();
         for i in 0..8 {
-            let top = Vec3::new(0.2, tree.metrics().height_m + 0.1, 0.1);
+            // Points in the perception reach of the highest tip.
+            let perception = space::radii(&tree).1;
+            let top = tree
+                .skeleton
+                .internodes
+                .iter()
+                .map(|n| n.end)
+                .max_by(|a, b| a.y.total_cmp(&b.y))
+                .expect("a tree has internodes");
             for _ in 0..80 {
                 tree.environment
                     .attraction
-                    .add_persistent(top + rng.in_unit_ball() * 0.3);
+                    .add_persistent(top + rng.in_unit_ball() * perception);
             }
             if i == 3 {
                 // Other light parameters: every exposure is computed again.
