@@ -422,7 +422,10 @@ impl Tree {
         (exposure / s.full_exposure).clamp(0.0, 1.0)
     }
 
-    /// Recomputes every diameter by the pipe model (module `widths`); call after edits.
+    /// Recomputes every diameter by the pipe model (module `widths`); call after edits. Growth
+    /// keeps the pipe-model sums of this update and, after an iteration that only added
+    /// internodes, recomputes only their paths: an edit that changes links or width
+    /// constraints outside growth must call this (the `edit` module's do).
     pub fn update_widths(&mut self) {
         let mut scratch = std::mem::take(&mut self.scratch);
         widths::update(

@@ -165,10 +165,8 @@ pub(crate) fn update_after_growth(
             return false;
         }
     }
-    if nodes[num_before..]
-        .iter()
-        .any(|c| c.width_constraint.is_some())
-    {
+    let constrained = |i: usize| nodes[i].width_constraint.is_some();
+    if (num_before..n).any(constrained) || dirty.iter().any(|&i| constrained(i as usize)) {
         return false;
     }
     dirty.sort_unstable_by(|a, b| b.cmp(a));
