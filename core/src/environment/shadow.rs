@@ -291,6 +291,13 @@ impl ShadowGrid {
         brick != NO_BRICK && self.brick_version[brick as usize] > version
     }
 
+    /// How many of the grid's bricks a change since `version` touched, and how many bricks it
+    /// has (a reader can tell whether asking [`ShadowGrid::changed_since`] point by point pays).
+    pub fn bricks_changed_since(&self, version: u64) -> (usize, usize) {
+        let changed = self.brick_version.iter().filter(|&&v| v > version).count();
+        (changed, self.num_bricks)
+    }
+
     /// Shadow value s at a point (0 where no node casts shade).
     pub fn shadow_at(&self, point_in_world: Vec3) -> f32 {
         if !point_in_world.is_finite() {

@@ -13,6 +13,10 @@ use crate::tree::Internode;
 /// Nodes per block of the parallel pass over the tree (a block outweighs handing it over).
 const PARALLEL_NODES: usize = 4096;
 
+/// [`collect`] keeps the light exposures of nodes in unchanged bricks only when at most one
+/// brick in this many changed since the previous iteration.
+const KEEP_LIGHT_CHANGED_BRICKS: usize = 4;
+
 /// Slot of a terminal bud in [`BudState::slot`]; lateral buds use their index.
 pub(crate) const TERMINAL: u32 = u32::MAX;
 
@@ -102,9 +106,15 @@ pub(crate) fn collect(tree: &mut Tree, scratch: &mut Scratch) {
         full_exposure: species.full_exposure.to_bits(),
         shadow_strength: species.shadow_strength.to_bits(),
     };
+    // When most bricks changed (autonomous growth, as a rule), asking brick by brick costs
+    // more than it saves: every exposure is computed (the same values either way).
     let light_seen = scratch
         .light_seen
         .filter(|seen| seen.key == light_key && seen.iteration + 1 == tree.iteration)
+        .filter(|seen| {
+            let (changed, bricks) = shadow.bricks_changed_since(seen.version);
+            changed.saturating_mul(KEEP_LIGHT_CHANGED_BRICKS) <= bricks
+        })
         .map(|seen| (seen.version, seen.iteration));
     scratch.light_seen = Some(LightSeen {
         key: light_key,
