@@ -133,6 +133,8 @@ pub(crate) struct Scratch {
     pub size: Vec<u32>,
     pub in_mask: Vec<bool>,
     pub acc: Vec<f64>,
+    /// What `acc` holds the sums of, when they describe the arena ([`widths`]).
+    pub widths_of: Option<widths::WidthsOf>,
     pub subtree_root: Vec<u32>,
     /// The arena's links as bud collection reads them, compact for the passes that follow
     /// before the arena changes (both vigor passes, shedding): main child of node i
@@ -141,16 +143,23 @@ pub(crate) struct Scratch {
     pub main_child: Vec<u32>,
     pub lateral_range: Vec<(u32, u32)>,
     pub lateral: Vec<u32>,
+    /// Nodes on the paths from the enabled buds to the base, and a flag per node ([`vigor`]'s
+    /// pass along those paths).
+    pub on_path: Vec<bool>,
+    pub path_nodes: Vec<u32>,
     /// Every node born before this iteration had all its lateral buds dead at the start of
     /// iteration `expired_at` ([`buds::collect`] kills them once they outlive the bud lifetime).
     pub expired_below: u32,
     pub expired_at: Option<u32>,
+    /// What the last bud collection computed the nodes' light exposures from
+    /// ([`buds::collect`] keeps those whose shadow cannot have changed since).
+    pub light_seen: Option<buds::LightSeen>,
     /// The autonomous points of each block of buds, and the generator's draws before each
     /// block (the parallel point generation, [`space`]).
     pub point_blocks: Vec<Vec<crate::environment::AttractionPoint>>,
     pub point_block_draws: Vec<u64>,
     /// Living buds and lateral children of each block of nodes ([`buds::collect`]).
-    pub block_counts: Vec<(u32, u32)>,
+    pub bud_blocks: Vec<buds::BudBlock>,
 }
 
 /// No part of a tree lies further than this from its base (metres): beyond any real tree, a
@@ -302,7 +311,7 @@ impl Tree {
         clock.lap(timing::Phase::Space);
         stats.num_enabled_buds = light::bud_input(self, &mut scratch);
         clock.lap(timing::Phase::BudInput);
-        let v_max = vigor::distribute(self, &mut scratch);
+        let v_max = vigor::distribute(self, &mut scratch, options.autonomous);
         stats.num_buds = scratch.buds.len();
         let shed = if options.autonomous && v_max > 0.0 {
             vigor::select_shed(self, &mut scratch, v_max)
@@ -311,6 +320,7 @@ impl Tree {
         };
         let removed = subtree_flags(&scratch, &shed);
         clock.lap(timing::Phase::Vigor);
+        let num_before = self.skeleton.len();
         let grown = shoots::grow_all(self, &mut scratch, v_max, &removed, options.scene);
         stats.num_shoots = grown.0;
         stats.num_new_internodes = grown.1;
@@ -327,8 +337,23 @@ impl Tree {
         clock.lap(timing::Phase::Shed);
         space::finish_iteration(self, &scratch);
         clock.lap(timing::Phase::Finish);
-        self.scratch = scratch;
-        self.update_widths();
+        // When internodes were only added, the widths change along their paths to the base.
+        let only_added = stats.num_shed_internodes == 0 && stats.num_pruned_internodes == 0;
+        if !(only_added
+            && widths::update_after_growth(
+                &mut self.skeleton,
+                self.species.tip_diameter_m,
+                self.species.pipe_exponent,
+                &mut self.pipe_exponents,
+                &mut scratch,
+                num_before,
+            ))
+        {
+            self.scratch = scratch;
+            self.update_widths();
+        } else {
+            self.scratch = scratch;
+        }
         clock.lap(timing::Phase::Widths);
         stats
     }
@@ -397,7 +422,10 @@ impl Tree {
         (exposure / s.full_exposure).clamp(0.0, 1.0)
     }
 
-    /// Recomputes every diameter by the pipe model (module `widths`); call after edits.
+    /// Recomputes every diameter by the pipe model (module `widths`); call after edits. Growth
+    /// keeps the pipe-model sums of this update and, after an iteration that only added
+    /// internodes, recomputes only their paths: an edit that changes links or width
+    /// constraints outside growth must call this (the `edit` module's do).
     pub fn update_widths(&mut self) {
         let mut scratch = std::mem::take(&mut self.scratch);
         widths::update(
@@ -572,5 +600,92 @@ impl PartialEq for Tree {
             && self.environment.attraction == other.environment.attraction
             && self.growth_mask == other.growth_mask
             && self.rng == other.rng
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use glam::Vec3;
+
+    use super::*;
+
+    /// Steps `tree` (keeping its working memory) and a clone of it made before every step
+    /// (empty working memory: every pass over the whole tree) and checks they stay equal,
+    /// widths and light exposures included.
+    fn step_both(kept: &mut Tree, options: StepOptions, what: &str) {
+        let mut fresh = kept.clone();
+        kept.step(options);
+        fresh.step(options);
+        assert!(*kept == fresh, "{what}");
+        for (i, (a, b)) in kept
+            .skeleton
+            .internodes
+            .iter()
+            .zip(&fresh.skeleton.internodes)
+            .enumerate()
+        {
+            assert_eq!(
+                a.diameter.to_bits(),
+                b.diameter.to_bits(),
+                "{what}: node {i}"
+            );
+            assert_eq!(
+                a.light_exposure.to_bits(),
+                b.light_exposure.to_bits(),
+                "{what}: node {i}"
+            );
+        }
+    }
+
+    #[test]
+    fn kept_sums_and_exposures_grow_the_same_tree_as_passes_over_the_whole_tree() {
+        let species = Species::by_name("maple").expect("maple preset");
+        let mut tree = Tree::new(species, 9);
+        let autonomous = StepOptions {
+            autonomous: true,
+            scene: None,
+        };
+        let brushed = StepOptions {
+            autonomous: false,
+            scene: None,
+        };
+        for i in 0..6 {
+            step_both(&mut tree, autonomous, &format!("autonomous {i}"));
+        }
+        let mut rng = crate::rng::Rng::new(3);
+        let brushed_from = tree.skeleton.len();
+        for i in 0..8 {
+            // Points in the perception reach of the highest tip.
+            let perception = space::radii(&tree).1;
+            let top = tree
+                .skeleton
+                .internodes
+                .iter()
+                .map(|n| n.end)
+                .max_by(|a, b| a.y.total_cmp(&b.y))
+                .expect("a tree has internodes");
+            for _ in 0..80 {
+                tree.environment
+                    .attraction
+                    .add_persistent(top + rng.in_unit_ball() * perception);
+            }
+            if i == 3 {
+                // Other light parameters: every exposure is computed again.
+                tree.species.shadow_strength *= 1.5;
+            }
+            if i == 5 {
+                // Shade from outside growth (a garden's neighbours).
+                tree.environment
+                    .shadow
+                    .apply_nodes([top - Vec3::Y * 0.5, top + Vec3::X * 0.2], 1);
+            }
+            step_both(&mut tree, brushed, &format!("brushed {i}"));
+        }
+        assert!(
+            tree.skeleton.len() > brushed_from && brushed_from > 300,
+            "{brushed_from} → {}",
+            tree.skeleton.len()
+        );
+        step_both(&mut tree, autonomous, "autonomous after brushing");
     }
 }

@@ -6,7 +6,34 @@
 
 use glam::{IVec3, Vec3};
 
+use rayon::prelude::*;
+
 use super::candidates::Candidates;
+
+/// At least this many points make a rebuild compute their cells and bounds on all threads.
+const PARALLEL_ENTRIES: usize = 32 * 1024;
+/// Points per block of those parallel passes.
+const PARALLEL_CHUNK: usize = 8 * 1024;
+/// At most this many runs of cells fill a large grid (each scans every entry).
+const MAX_FILL_RUNS: usize = 4;
+
+/// The smallest box holding every position (not empty). Minimum and maximum are exact, so
+/// blocks combined in any order give the same box.
+fn bounds(positions: &[Vec3]) -> (Vec3, Vec3) {
+    let serial = |chunk: &[Vec3]| {
+        chunk
+            .iter()
+            .fold((chunk[0], chunk[0]), |(lo, hi), &p| (lo.min(p), hi.max(p)))
+    };
+    if positions.len() < PARALLEL_ENTRIES {
+        return serial(positions);
+    }
+    positions
+        .par_chunks(PARALLEL_CHUNK)
+        .map(serial)
+        .reduce_with(|a, b| (a.0.min(b.0), a.1.max(b.1)))
+        .unwrap_or((positions[0], positions[0]))
+}
 
 /// At most this many cells per stored point (plus a constant): a sparse cloud gets bigger cells.
 const MAX_CELLS_PER_POINT: usize = 4;
@@ -69,11 +96,7 @@ impl SpatialGrid {
             self.cell_start.push(0);
             return;
         }
-        let (mut min, mut max) = (positions[0], positions[0]);
-        for p in positions {
-            min = min.min(*p);
-            max = max.max(*p);
-        }
+        let (min, max) = bounds(positions);
         let extent = (max - min).max(Vec3::splat(1e-6));
         let budget = (positions.len() * MAX_CELLS_PER_POINT).max(MIN_CELL_BUDGET) as f32;
         let mut cell = cell_size.max(1e-6);
@@ -88,10 +111,27 @@ impl SpatialGrid {
         let num_cells = (self.dims.x * self.dims.y * self.dims.z) as usize;
         clear_with_room(&mut self.cell_start, num_cells + 1);
         self.cell_start.resize(num_cells + 1, 0);
-        for p in positions {
-            let c = self.cell_index(self.cell_coord(*p));
-            self.cell_of.push(c as u32);
-            self.cell_start[c + 1] += 1;
+        // Each position's cell (on all threads for a large set: every value is computed alone,
+        // so the grid is the same on any number of threads), then the counts.
+        let mut cell_of = std::mem::take(&mut self.cell_of);
+        cell_of.resize(n, 0);
+        let grid = &*self;
+        let cell_of_chunk = |cells: &mut [u32], chunk: &[Vec3]| {
+            for (c, p) in cells.iter_mut().zip(chunk) {
+                *c = grid.cell_index(grid.cell_coord(*p)) as u32;
+            }
+        };
+        if n >= PARALLEL_ENTRIES {
+            cell_of
+                .par_chunks_mut(PARALLEL_CHUNK)
+                .zip(positions.par_chunks(PARALLEL_CHUNK))
+                .for_each(|(cells, chunk)| cell_of_chunk(cells, chunk));
+        } else {
+            cell_of_chunk(&mut cell_of, positions);
+        }
+        self.cell_of = cell_of;
+        for &c in &self.cell_of {
+            self.cell_start[c as usize + 1] += 1;
         }
         for c in 0..num_cells {
             self.cell_start[c + 1] += self.cell_start[c];
@@ -99,21 +139,98 @@ impl SpatialGrid {
         self.entry_index.resize(positions.len(), 0);
         self.entry_position.resize(positions.len(), Vec3::ZERO);
         // Fill each cell in input order (stable): the cursor is cell_start shifted by one.
-        for (i, p) in positions.iter().enumerate() {
-            let c = self.cell_of[i] as usize;
-            let slot = self.cell_start[c] as usize;
-            self.cell_start[c] += 1;
-            self.entry_index[slot] = i as u32;
-            self.entry_position[slot] = *p;
-        }
+        self.fill_cells(positions, num_cells);
         if by_coordinate {
-            self.entry_x.extend(self.entry_position.iter().map(|p| p.x));
-            self.entry_y.extend(self.entry_position.iter().map(|p| p.y));
-            self.entry_z.extend(self.entry_position.iter().map(|p| p.z));
+            let (xs, ys, zs) = (&mut self.entry_x, &mut self.entry_y, &mut self.entry_z);
+            let sorted = &self.entry_position;
+            let split =
+                |out: &mut Vec<f32>, axis: usize| out.extend(sorted.iter().map(|p| p[axis]));
+            if n >= PARALLEL_ENTRIES {
+                rayon::join(
+                    || split(xs, 0),
+                    || rayon::join(|| split(ys, 1), || split(zs, 2)),
+                );
+            } else {
+                split(xs, 0);
+                split(ys, 1);
+                split(zs, 2);
+            }
         }
         // The cursors ended at each cell's end: shifted by one cell they are the starts.
         self.cell_start.copy_within(0..num_cells, 1);
         self.cell_start[0] = 0;
+    }
+
+    /// Writes every entry to its cell's next slot, in input order within each cell (the cells'
+    /// starts in `cell_start[..num_cells]` become their ends). For a large set, the cells are
+    /// cut into one run per thread holding about as many entries; each run scans all entries
+    /// and fills only its own cells, so every slot gets what the serial fill gives it.
+    fn fill_cells(&mut self, positions: &[Vec3], num_cells: usize) {
+        let n = positions.len();
+        let threads = rayon::current_num_threads().min(MAX_FILL_RUNS);
+        let cell_of = &self.cell_of;
+        let fill = |cells: std::ops::Range<usize>,
+                    cursors: &mut [u32],
+                    first_slot: usize,
+                    index: &mut [u32],
+                    position: &mut [Vec3]| {
+            for (i, (&c, p)) in cell_of.iter().zip(positions).enumerate() {
+                let c = c as usize;
+                if cells.contains(&c) {
+                    let cursor = &mut cursors[c - cells.start];
+                    let slot = *cursor as usize - first_slot;
+                    *cursor += 1;
+                    index[slot] = i as u32;
+                    position[slot] = *p;
+                }
+            }
+        };
+        if n < PARALLEL_ENTRIES || threads <= 1 {
+            fill(
+                0..num_cells,
+                &mut self.cell_start[..num_cells],
+                0,
+                &mut self.entry_index,
+                &mut self.entry_position,
+            );
+            return;
+        }
+        // Run k starts at the first cell whose entries start at or after k·n/threads.
+        let mut starts: Vec<usize> = (0..threads)
+            .map(|k| {
+                self.cell_start[..num_cells].partition_point(|&s| (s as usize) < k * n / threads)
+            })
+            .collect();
+        starts[0] = 0;
+        starts.push(num_cells);
+        starts.dedup();
+        let mut runs = Vec::with_capacity(starts.len());
+        let (mut cursors, mut index, mut position) = (
+            &mut self.cell_start[..num_cells],
+            &mut self.entry_index[..],
+            &mut self.entry_position[..],
+        );
+        for w in starts.windows(2) {
+            let (c0, c1) = (w[0], w[1]);
+            let first_slot = cursors[0] as usize;
+            let last_slot = if c1 - c0 < cursors.len() {
+                cursors[c1 - c0] as usize
+            } else {
+                n
+            };
+            let (run_cursors, rest) = std::mem::take(&mut cursors).split_at_mut(c1 - c0);
+            cursors = rest;
+            let (run_index, rest) = std::mem::take(&mut index).split_at_mut(last_slot - first_slot);
+            index = rest;
+            let (run_position, rest) =
+                std::mem::take(&mut position).split_at_mut(last_slot - first_slot);
+            position = rest;
+            runs.push((c0..c1, run_cursors, first_slot, run_index, run_position));
+        }
+        runs.into_par_iter()
+            .for_each(|(cells, cursors, first_slot, index, position)| {
+                fill(cells, cursors, first_slot, index, position)
+            });
     }
 
     pub fn len(&self) -> usize {
@@ -454,6 +571,60 @@ mod tests {
             kept.for_each_within(center, radius, |i, p, d2| some.push((i, p, d2)));
             all.retain(|&(i, _, _)| i % 3 != 0);
             assert_eq!(all, some);
+        }
+    }
+
+    /// A grid of `points` built on a pool of `threads` threads.
+    fn built_on(threads: usize, points: &[Vec3], cell: f32, by_coordinate: bool) -> SpatialGrid {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .expect("thread pool");
+        let mut grid = SpatialGrid::default();
+        pool.install(|| grid.rebuild_with(points, cell, by_coordinate));
+        grid
+    }
+
+    #[test]
+    fn large_grids_built_on_several_threads_match_the_serial_build() {
+        let mut rng = Rng::new(8);
+        // Clustered, so that the runs of cells hold very different numbers of cells.
+        let mut points: Vec<Vec3> = (0..3 * PARALLEL_ENTRIES)
+            .map(|i| {
+                let spread = if i % 4 == 0 { 3.0 } else { 0.3 };
+                rng.in_unit_ball() * spread + Vec3::new(1.0, 0.5, -2.0)
+            })
+            .collect();
+        // Duplicates keep their input order within a cell.
+        points.extend_from_within(..1000);
+        for by_coordinate in [false, true] {
+            let serial = built_on(1, &points, 0.05, by_coordinate);
+            for threads in [2, 3, 8] {
+                let parallel = built_on(threads, &points, 0.05, by_coordinate);
+                assert_eq!(parallel.origin, serial.origin);
+                assert_eq!(parallel.dims, serial.dims);
+                assert_eq!(parallel.cell_start, serial.cell_start);
+                assert_eq!(parallel.entry_index, serial.entry_index);
+                assert_eq!(parallel.entry_position, serial.entry_position);
+                assert_eq!(parallel.entry_x, serial.entry_x);
+                assert_eq!(parallel.entry_z, serial.entry_z);
+            }
+            let entries: Vec<(u32, Vec3)> = serial.entries().collect();
+            assert_eq!(entries.len(), points.len());
+            let mut seen = vec![false; points.len()];
+            for w in entries.windows(2) {
+                let (a, b) = (w[0], w[1]);
+                let (ca, cb) = (
+                    serial.cell_index(serial.cell_coord(a.1)),
+                    serial.cell_index(serial.cell_coord(b.1)),
+                );
+                assert!(ca < cb || (ca == cb && a.0 < b.0), "{a:?} then {b:?}");
+            }
+            for (i, p) in entries {
+                assert_eq!(points[i as usize], p);
+                seen[i as usize] = true;
+            }
+            assert!(seen.iter().all(|&s| s));
         }
     }
 

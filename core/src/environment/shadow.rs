@@ -147,7 +147,12 @@ const BRICKS_PER_CHUNK: usize = 64;
 /// Shadow values in bricks of 8³ voxels, allocated on first touch and found through a dense
 /// index over brick coordinates. Growing the crown only grows the small index; bricks never move,
 /// so the cost of adding a node is its pyramid alone, whatever the size of the tree.
-#[derive(Clone, Debug, Default)]
+///
+/// Every grid (a clone too) has its own [`ShadowGrid::id`], and every change bumps its
+/// [`ShadowGrid::version`] and marks the bricks it touched with it, so that a reader can tell
+/// whether the shadow at a point may have changed since it last looked
+/// ([`ShadowGrid::changed_since`]).
+#[derive(Debug)]
 pub struct ShadowGrid {
     voxel_size: f32,
     /// Δs per pyramid level q, in fixed-point units.
@@ -164,6 +169,55 @@ pub struct ShadowGrid {
     /// Working memory of [`ShadowGrid::apply_node`]: the bricks a pyramid reaches (index,
     /// brick coordinates, levels in it).
     reached: Vec<PyramidBrick>,
+    /// This grid's own number (see [`ShadowGrid::id`]).
+    id: u64,
+    /// Changes so far, and the change that last touched each brick (by brick index).
+    version: u64,
+    brick_version: Vec<u64>,
+}
+
+/// The next [`ShadowGrid::id`].
+static NEXT_GRID_ID: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(1);
+
+fn fresh_grid_id() -> u64 {
+    NEXT_GRID_ID.fetch_add(1, std::sync::atomic::Ordering::Relaxed)
+}
+
+impl Default for ShadowGrid {
+    fn default() -> Self {
+        ShadowGrid {
+            voxel_size: 0.0,
+            level_units: Vec::new(),
+            min_brick: IVec3::ZERO,
+            brick_dims: IVec3::ZERO,
+            brick_of: Vec::new(),
+            chunks: Vec::new(),
+            num_bricks: 0,
+            reached: Vec::new(),
+            id: fresh_grid_id(),
+            version: 0,
+            brick_version: Vec::new(),
+        }
+    }
+}
+
+impl Clone for ShadowGrid {
+    /// The same values under a new [`ShadowGrid::id`]: the copy's changes are its own.
+    fn clone(&self) -> Self {
+        ShadowGrid {
+            voxel_size: self.voxel_size,
+            level_units: self.level_units.clone(),
+            min_brick: self.min_brick,
+            brick_dims: self.brick_dims,
+            brick_of: self.brick_of.clone(),
+            chunks: self.chunks.clone(),
+            num_bricks: self.num_bricks,
+            reached: Vec::new(),
+            id: fresh_grid_id(),
+            version: self.version,
+            brick_version: self.brick_version.clone(),
+        }
+    }
 }
 
 impl ShadowGrid {
@@ -208,6 +262,42 @@ impl ShadowGrid {
         Some((o.x + self.brick_dims.x * (o.y + self.brick_dims.y * o.z)) as usize)
     }
 
+    /// A number no other grid of this process has (a clone gets a new one).
+    pub fn id(&self) -> u64 {
+        self.id
+    }
+
+    /// How many changes (calls of [`ShadowGrid::apply_node`] and
+    /// [`ShadowGrid::apply_nodes`]) this grid has seen.
+    pub fn version(&self) -> u64 {
+        self.version
+    }
+
+    /// False when the shadow at `point_in_world` is certainly what it was when the grid was
+    /// at `version` ([`ShadowGrid::version`]): no change since touched the brick holding it
+    /// (a point in no brick has had no shade since the grid began). True otherwise.
+    pub fn changed_since(&self, point_in_world: Vec3, version: u64) -> bool {
+        if version >= self.version {
+            return false;
+        }
+        if !point_in_world.is_finite() {
+            return false;
+        }
+        let v = self.voxel_of(point_in_world);
+        let Some(cell) = self.brick_cell(v >> BRICK_SHIFT) else {
+            return false;
+        };
+        let brick = self.brick_of[cell];
+        brick != NO_BRICK && self.brick_version[brick as usize] > version
+    }
+
+    /// How many of the grid's bricks a change since `version` touched, and how many bricks it
+    /// has (a reader can tell whether asking [`ShadowGrid::changed_since`] point by point pays).
+    pub fn bricks_changed_since(&self, version: u64) -> (usize, usize) {
+        let changed = self.brick_version.iter().filter(|&&v| v > version).count();
+        (changed, self.num_bricks)
+    }
+
     /// Shadow value s at a point (0 where no node casts shade).
     pub fn shadow_at(&self, point_in_world: Vec3) -> f32 {
         if !point_in_world.is_finite() {
@@ -242,6 +332,7 @@ impl ShadowGrid {
     /// A first pass over the same rows only asks for their cache lines, so that the second
     /// waits on memory once for all of them rather than once per row.
     pub fn apply_node(&mut self, node_in_world: Vec3, sign: i32) {
+        self.version += 1;
         let mut reached = std::mem::take(&mut self.reached);
         if let Some(top) = self.plan_pyramid(node_in_world, &mut reached) {
             self.add_pyramid(top, &reached, sign);
@@ -289,6 +380,7 @@ impl ShadowGrid {
     /// in voxel `top` over the bricks `reached` that [`ShadowGrid::plan_pyramid`] found.
     fn add_pyramid(&mut self, top: IVec3, reached: &[PyramidBrick], sign: i32) {
         for (brick, b, levels) in reached {
+            self.brick_version[*brick] = self.version;
             let (units, layers) = self.brick_layers_mut(*brick);
             for q in levels.clone() {
                 let square = Square::of_level(top, q, *b);
@@ -313,6 +405,7 @@ impl ShadowGrid {
     /// find their bricks in cache, and each node's rows asked for while the previous node's
     /// are updated.
     pub fn apply_nodes(&mut self, nodes: impl IntoIterator<Item = Vec3>, sign: i32) {
+        self.version += 1;
         let mut keyed: Vec<(u64, Vec3)> = nodes
             .into_iter()
             .map(|p| {
@@ -362,6 +455,7 @@ impl ShadowGrid {
             }
             self.brick_of[cell] = self.num_bricks as u32;
             self.num_bricks += 1;
+            self.brick_version.push(self.version);
         }
         self.brick_of[cell] as usize
     }

@@ -13,6 +13,10 @@ use crate::tree::Internode;
 /// Nodes per block of the parallel pass over the tree (a block outweighs handing it over).
 const PARALLEL_NODES: usize = 4096;
 
+/// [`collect`] keeps the light exposures of nodes in unchanged bricks only when at most one
+/// brick in this many changed since the previous iteration.
+const KEEP_LIGHT_CHANGED_BRICKS: usize = 4;
+
 /// Slot of a terminal bud in [`BudState::slot`]; lateral buds use their index.
 pub(crate) const TERMINAL: u32 = u32::MAX;
 
@@ -29,8 +33,6 @@ pub(crate) struct BudState {
     /// v: vigor reaching the bud.
     pub vigor: f32,
     pub enabled: bool,
-    /// In the selective-growth mask (or no mask set).
-    pub may_grow: bool,
     /// Takes part in the competition for space this iteration (may grow and is not in full
     /// shade when light matters).
     pub competes: bool,
@@ -47,11 +49,12 @@ fn bud_cutoff(tree: &Tree) -> Option<u32> {
     tree.iteration.checked_sub(lifetime)
 }
 
-/// Two passes over the tree, both on all threads by blocks of nodes: kills lateral buds older
-/// than the bud lifetime, sets the light exposure L of every node that has buds (step 1,
-/// [`super::light`]) and counts the buds, then fills `scratch.buds` with every living bud, node by node (terminal first), with the
-/// mask, and takes the arena's compact links (`scratch.main_child`, `lateral_range`,
-/// `lateral`).
+/// One pass over the tree on all threads by blocks of nodes: kills lateral buds older than the
+/// bud lifetime, sets the light exposure L of every node that has buds (step 1,
+/// [`super::light`]), lists every living bud, node by node (terminal first), with the mask,
+/// and takes the arena's compact links (`scratch.main_child`, `lateral_range`, `lateral`);
+/// then the blocks' lists are copied into `scratch.buds` and `scratch.lateral` (a pass over
+/// compact lists, not the arena).
 pub(crate) fn collect(tree: &mut Tree, scratch: &mut Scratch) {
     let cutoff = bud_cutoff(tree);
     // Nodes born before `expired` had every lateral bud killed by an earlier pass of this tree
@@ -93,6 +96,31 @@ pub(crate) fn collect(tree: &mut Tree, scratch: &mut Scratch) {
     }
     let (species, shadow) = (&tree.species, &tree.environment.shadow);
     let light_matters = species.light_sensitivity > 0.0;
+    // A node that had living buds at the previous iteration's collection got its exposure
+    // then; if the grid is the same one and no change since touched the node's brick, the
+    // same formula would give the same value, so it is kept. New nodes (born since, with the
+    // exposure their shoot gave them) and every node after anything else (a clone, a loaded
+    // tree, another grid, other light parameters) get it computed.
+    let light_key = LightKey {
+        grid: shadow.id(),
+        full_exposure: species.full_exposure.to_bits(),
+        shadow_strength: species.shadow_strength.to_bits(),
+    };
+    // When most bricks changed (autonomous growth, as a rule), asking brick by brick costs
+    // more than it saves: every exposure is computed (the same values either way).
+    let light_seen = scratch
+        .light_seen
+        .filter(|seen| seen.key == light_key && seen.iteration + 1 == tree.iteration)
+        .filter(|seen| {
+            let (changed, bricks) = shadow.bricks_changed_since(seen.version);
+            changed.saturating_mul(KEEP_LIGHT_CHANGED_BRICKS) <= bricks
+        })
+        .map(|seen| (seen.version, seen.iteration));
+    scratch.light_seen = Some(LightSeen {
+        key: light_key,
+        version: shadow.version(),
+        iteration: tree.iteration,
+    });
     let Scratch {
         buds,
         node_bud_start,
@@ -101,136 +129,163 @@ pub(crate) fn collect(tree: &mut Tree, scratch: &mut Scratch) {
         main_child,
         lateral_range,
         lateral,
-        block_counts,
+        bud_blocks,
         ..
     } = scratch;
-    // On all threads, by blocks of nodes: the expired lateral buds die, a node left with a
-    // living bud gets the light exposure of its buds, and each block counts its living buds and
-    // lateral children (each node is its own: any thread count gives the same values).
-    nodes
-        .par_chunks_mut(PARALLEL_NODES)
-        .map(|block| {
-            let (mut num_buds, mut num_laterals) = (0u32, 0u32);
-            for node in block {
-                let expired_before = node.born_iteration < expired;
-                if !expired_before
-                    && cutoff.is_some_and(|c| node.born_iteration < c)
-                    && node.lateral_buds.iter().any(|b| b.alive)
-                {
-                    for bud in &mut node.lateral_buds {
-                        bud.alive = false;
-                    }
-                }
-                let terminal = node.terminal_bud.as_ref().is_some_and(|b| b.alive);
-                let laterals = if expired_before {
-                    0
-                } else {
-                    node.lateral_buds.iter().filter(|b| b.alive).count() as u32
-                };
-                if terminal || laterals > 0 {
-                    node.light_exposure = super::light::exposure(species, shadow, node.end);
-                }
-                num_buds += u32::from(terminal) + laterals;
-                num_laterals += node.lateral_children.len() as u32;
-            }
-            (num_buds, num_laterals)
-        })
-        .collect_into_vec(block_counts);
-    let nodes = &*nodes;
-    // Then, again by blocks on all threads, each block fills its own part of the bud list
-    // (node by node, terminal first) and of the links, at offsets summed from the counts.
-    let (total_buds, total_laterals) = block_counts
-        .iter()
-        .fold((0usize, 0usize), |(b, l), &(nb, nl)| {
-            (b + nb as usize, l + nl as usize)
-        });
-    buds.resize(total_buds, BudState::UNSET);
     node_bud_start.resize(n + 1, 0);
     node_end.resize(n, Vec3::ZERO);
     main_child.resize(n, super::NO_NODE);
     lateral_range.resize(n, (0, 0));
-    lateral.resize(total_laterals, 0);
-    node_bud_start[n] = total_buds as u32;
-    let mut parts = Vec::with_capacity(block_counts.len());
-    let (mut bud_rest, mut lateral_rest) = (&mut buds[..], &mut lateral[..]);
-    let (mut bud_base, mut lateral_base) = (0usize, 0usize);
-    for &(nb, nl) in block_counts.iter() {
-        let (bud_part, bud_tail) = bud_rest.split_at_mut(nb as usize);
-        let (lateral_part, lateral_tail) = lateral_rest.split_at_mut(nl as usize);
-        parts.push((bud_part, bud_base, lateral_part, lateral_base));
-        (bud_rest, lateral_rest) = (bud_tail, lateral_tail);
-        bud_base += nb as usize;
-        lateral_base += nl as usize;
+    let num_blocks = n.div_ceil(PARALLEL_NODES);
+    if bud_blocks.len() < num_blocks {
+        bud_blocks.resize_with(num_blocks, BudBlock::default);
     }
+    // One pass over the arena, on all threads by blocks of nodes: the expired lateral buds
+    // die, a node left with a living bud gets the light exposure of its buds, and each block
+    // lists its living buds (node by node, terminal first) and lateral children in its own
+    // buffers and writes its nodes' links with offsets into those buffers (each node is its
+    // own: any thread count gives the same values).
     nodes
-        .par_chunks(PARALLEL_NODES)
+        .par_chunks_mut(PARALLEL_NODES)
         .zip(node_bud_start[..n].par_chunks_mut(PARALLEL_NODES))
         .zip(node_end.par_chunks_mut(PARALLEL_NODES))
         .zip(main_child.par_chunks_mut(PARALLEL_NODES))
         .zip(lateral_range.par_chunks_mut(PARALLEL_NODES))
         .zip(in_mask.par_chunks(PARALLEL_NODES))
-        .zip(parts.into_par_iter())
+        .zip(bud_blocks[..num_blocks].par_iter_mut())
         .enumerate()
         .for_each(
-            |(block, ((((((block_nodes, starts), ends), mains), ranges), mask), part))| {
-                let (block_buds, bud_base, block_laterals, lateral_base) = part;
-                let (mut b, mut l) = (0usize, 0usize);
-                for (k, node) in block_nodes.iter().enumerate() {
+            |(block, ((((((block_nodes, starts), ends), mains), ranges), mask), out))| {
+                out.buds.clear();
+                out.lateral.clear();
+                for (k, node) in block_nodes.iter_mut().enumerate() {
                     let i = block * PARALLEL_NODES + k;
                     let expired_before = node.born_iteration < expired;
-                    let first = b;
-                    starts[k] = (bud_base + first) as u32;
+                    if !expired_before
+                        && cutoff.is_some_and(|c| node.born_iteration < c)
+                        && node.lateral_buds.iter().any(|b| b.alive)
+                    {
+                        for bud in &mut node.lateral_buds {
+                            bud.alive = false;
+                        }
+                    }
+                    let terminal = node.terminal_bud.as_ref().is_some_and(|b| b.alive);
+                    let laterals = !expired_before && node.lateral_buds.iter().any(|b| b.alive);
+                    let current = || {
+                        light_seen.is_some_and(|(version, iteration)| {
+                            node.born_iteration < iteration
+                                && !shadow.changed_since(node.end, version)
+                        })
+                    };
+                    if (terminal || laterals) && !current() {
+                        node.light_exposure = super::light::exposure(species, shadow, node.end);
+                    }
+                    let first = out.buds.len();
+                    starts[k] = first as u32;
                     ends[k] = node.end;
                     mains[k] = node.main_child.map_or(super::NO_NODE, |c| c.0);
-                    let lateral_start = lateral_base + l;
-                    for c in &node.lateral_children {
-                        block_laterals[l] = c.0;
-                        l += 1;
+                    let lateral_start = out.lateral.len() as u32;
+                    out.lateral
+                        .extend(node.lateral_children.iter().map(|c| c.0));
+                    ranges[k] = (lateral_start, out.lateral.len() as u32);
+                    if !(terminal || laterals) {
+                        continue;
                     }
-                    ranges[k] = (lateral_start as u32, (lateral_base + l) as u32);
                     let may_grow = mask[k];
-                    let mut push = |slot: u32, direction: Vec3| {
-                        block_buds[b] = BudState {
-                            node: i as u32,
-                            slot,
-                            direction,
-                            light: 0.0,
-                            q: 0.0,
-                            vigor: 0.0,
-                            enabled: false,
-                            may_grow,
-                            competes: may_grow,
-                        };
-                        b += 1;
+                    // A bud in full shade (L = 0) can never grow when κ > 0 (Q = b·0^κ = 0):
+                    // it takes no part in the competition for space ([`super::space`]).
+                    let light = node.light_exposure;
+                    let competes = may_grow && (!light_matters || light > 0.0);
+                    let state = |slot: u32, direction: Vec3| BudState {
+                        node: i as u32,
+                        slot,
+                        direction,
+                        light,
+                        q: 0.0,
+                        vigor: 0.0,
+                        enabled: false,
+                        competes,
                     };
                     if let Some(bud) = &node.terminal_bud
                         && bud.alive
                     {
-                        push(TERMINAL, bud.direction);
+                        out.buds.push(state(TERMINAL, bud.direction));
                     }
-                    if !expired_before {
+                    if laterals {
                         for (slot, bud) in node.lateral_buds.iter().enumerate() {
                             if bud.alive {
-                                push(slot as u32, bud.direction);
+                                out.buds.push(state(slot as u32, bud.direction));
                             }
                         }
                     }
-                    if b > first {
-                        let light = node.light_exposure;
-                        // A bud in full shade (L = 0) can never grow when κ > 0 (Q = b·0^κ = 0):
-                        // it takes no part in the competition for space ([`super::space`]).
-                        let lit = !light_matters || light > 0.0;
-                        for bud in &mut block_buds[first..b] {
-                            bud.light = light;
-                            bud.competes = bud.may_grow && lit;
-                        }
-                    }
+                }
+            },
+        );
+    // Then, again by blocks on all threads, each block's buds and lateral children go to
+    // their place in the whole lists, and its offsets become offsets into those.
+    let (total_buds, total_laterals) = bud_blocks[..num_blocks]
+        .iter()
+        .fold((0usize, 0usize), |(b, l), block| {
+            (b + block.buds.len(), l + block.lateral.len())
+        });
+    buds.resize(total_buds, BudState::UNSET);
+    lateral.resize(total_laterals, 0);
+    node_bud_start[n] = total_buds as u32;
+    let mut parts = Vec::with_capacity(num_blocks);
+    let (mut bud_rest, mut lateral_rest) = (&mut buds[..], &mut lateral[..]);
+    let (mut bud_base, mut lateral_base) = (0u32, 0u32);
+    for block in &bud_blocks[..num_blocks] {
+        let (bud_part, bud_tail) = bud_rest.split_at_mut(block.buds.len());
+        let (lateral_part, lateral_tail) = lateral_rest.split_at_mut(block.lateral.len());
+        parts.push((bud_part, bud_base, lateral_part, lateral_base));
+        (bud_rest, lateral_rest) = (bud_tail, lateral_tail);
+        bud_base += block.buds.len() as u32;
+        lateral_base += block.lateral.len() as u32;
+    }
+    node_bud_start[..n]
+        .par_chunks_mut(PARALLEL_NODES)
+        .zip(lateral_range.par_chunks_mut(PARALLEL_NODES))
+        .zip(bud_blocks[..num_blocks].par_iter())
+        .zip(parts.into_par_iter())
+        .for_each(
+            |(((starts, ranges), block), (bud_part, bud_base, lateral_part, lateral_base))| {
+                bud_part.copy_from_slice(&block.buds);
+                lateral_part.copy_from_slice(&block.lateral);
+                for s in starts {
+                    *s += bud_base;
+                }
+                for r in ranges {
+                    *r = (r.0 + lateral_base, r.1 + lateral_base);
                 }
             },
         );
     let num_buds = scratch.buds.len();
     clear_with_room(&mut scratch.won, num_buds);
     scratch.won.resize(num_buds, WonPoints::default());
+}
+
+/// What the light exposures of [`collect`] were computed from: the shadow grid and the
+/// species' light parameters (bits).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct LightKey {
+    grid: u64,
+    full_exposure: u32,
+    shadow_strength: u32,
+}
+
+/// The last [`collect`]: its light key, the grid's version then and the iteration.
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct LightSeen {
+    key: LightKey,
+    version: u64,
+    iteration: u32,
+}
+
+/// One block's part of [`collect`]'s lists, kept between iterations.
+#[derive(Debug, Default)]
+pub(crate) struct BudBlock {
+    buds: Vec<BudState>,
+    lateral: Vec<u32>,
 }
 
 impl BudState {
@@ -243,7 +298,6 @@ impl BudState {
         q: 0.0,
         vigor: 0.0,
         enabled: false,
-        may_grow: false,
         competes: false,
     };
 }

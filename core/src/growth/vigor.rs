@@ -13,7 +13,22 @@ use crate::tree::NodeId;
 /// Runs both passes; returns v_max, the largest vigor of an enabled bud (0 if none). Both read
 /// the compact copy of the arena's links (see [`Scratch`]) that [`super::buds::collect`] took,
 /// which shedding uses too.
-pub(crate) fn distribute(tree: &Tree, scratch: &mut Scratch) -> f32 {
+///
+/// `every_node`: shedding follows, which reads the vigor and size of every branch. Without it
+/// (a brush-guided iteration) and with few enabled buds, both passes visit only the nodes on
+/// the paths from the enabled buds to the base ([`distribute_along_paths`]): every other node
+/// has Q = 0 below it, so it adds exactly 0 to its parent's sums and receives vigor 0.
+pub(crate) fn distribute(tree: &Tree, scratch: &mut Scratch, every_node: bool) -> f32 {
+    let few_enabled = || {
+        let enabled = scratch.buds.iter().filter(|b| b.enabled).count();
+        enabled.saturating_mul(PATH_PASS_BUDS_PER_NODE) <= tree.skeleton.len()
+    };
+    if !every_node
+        && few_enabled()
+        && let Some(v_max) = distribute_along_paths(tree, scratch)
+    {
+        return v_max;
+    }
     let n = tree.skeleton.len();
     let lambda = tree.species.apical_dominance_at(tree.age_years());
     let Scratch {
@@ -108,6 +123,129 @@ pub(crate) fn distribute(tree: &Tree, scratch: &mut Scratch) -> f32 {
     v_max
 }
 
+/// Enabled buds per node above which [`distribute_along_paths`] is not tried: their paths to
+/// the base would cover much of the tree.
+const PATH_PASS_BUDS_PER_NODE: usize = 64;
+
+/// [`distribute`] over the nodes on the paths from the nodes with enabled buds to the base
+/// only, in the same orders (descending, then ascending index) and with the same sums: a node
+/// off those paths holds no enabled bud in its subtree, so its Q_m + Q_l is 0 and leaving it
+/// out of a sum changes no bit (x + 0 = x for the non-negative sums here), and the vigor it
+/// and its buds receive is 0 (as [`super::buds::collect`] left the buds'). Subtree sizes are
+/// not computed (only shedding reads them). `None`, having changed no result, when the paths
+/// cover too much of the tree for this to pay.
+fn distribute_along_paths(tree: &Tree, scratch: &mut Scratch) -> Option<f32> {
+    let nodes = &tree.skeleton.internodes;
+    let n = nodes.len();
+    if n == 0 {
+        return None;
+    }
+    let Scratch {
+        buds,
+        node_bud_start,
+        q_main,
+        q_lateral,
+        vigor,
+        main_child,
+        lateral_range,
+        lateral,
+        on_path,
+        path_nodes,
+        ..
+    } = scratch;
+    // Mark the paths: from each node with an enabled bud up to the first node already marked.
+    on_path.clear();
+    on_path.resize(n, false);
+    path_nodes.clear();
+    let limit = n / 4;
+    for bud in buds.iter().filter(|b| b.enabled) {
+        let mut node = Some(bud.node as usize);
+        while let Some(i) = node {
+            if i >= n || on_path[i] {
+                break;
+            }
+            on_path[i] = true;
+            path_nodes.push(i as u32);
+            node = nodes[i].parent.map(|p| p.index());
+        }
+        if path_nodes.len() > limit {
+            return None;
+        }
+    }
+    path_nodes.sort_unstable();
+    let lambda = tree.species.apical_dominance_at(tree.age_years());
+    q_main.resize(n, 0.0);
+    q_lateral.resize(n, 0.0);
+    vigor.clear();
+    vigor.resize(n, 0.0);
+    for &i in path_nodes.iter().rev() {
+        let i = i as usize;
+        let (mut qm, mut ql) = (0.0, 0.0);
+        for bud in &buds[node_bud_start[i] as usize..node_bud_start[i + 1] as usize] {
+            if bud.slot == TERMINAL {
+                qm += bud.q;
+            } else {
+                ql += bud.q;
+            }
+        }
+        let c = main_child[i];
+        if c != NO_NODE && on_path[c as usize] {
+            qm += q_main[c as usize] + q_lateral[c as usize];
+        }
+        let (start, end) = lateral_range[i];
+        for &c in &lateral[start as usize..end as usize] {
+            let c = c as usize;
+            if on_path[c] {
+                ql += q_main[c] + q_lateral[c];
+            }
+        }
+        q_main[i] = qm;
+        q_lateral[i] = ql;
+    }
+    // The base is on every path (and there is none without an enabled bud).
+    if on_path[0] {
+        vigor[0] = q_main[0] + q_lateral[0];
+    }
+    let mut v_max = 0.0f32;
+    for &i in path_nodes.iter() {
+        let i = i as usize;
+        let (qm, ql) = (q_main[i], q_lateral[i]);
+        let denominator = lambda * qm + (1.0 - lambda) * ql;
+        let (vm, vl) = if denominator > 0.0 {
+            let v = vigor[i];
+            (
+                v * lambda * qm / denominator,
+                v * (1.0 - lambda) * ql / denominator,
+            )
+        } else {
+            (0.0, 0.0)
+        };
+        let lateral_share = if ql > 0.0 { vl / ql } else { 0.0 };
+        let has_main_child = main_child[i] != NO_NODE;
+        if has_main_child && on_path[main_child[i] as usize] {
+            vigor[main_child[i] as usize] = vm;
+        }
+        let (start, end) = lateral_range[i];
+        for &c in &lateral[start as usize..end as usize] {
+            let c = c as usize;
+            if on_path[c] {
+                vigor[c] = lateral_share * (q_main[c] + q_lateral[c]);
+            }
+        }
+        for bud in &mut buds[node_bud_start[i] as usize..node_bud_start[i + 1] as usize] {
+            bud.vigor = if bud.slot == TERMINAL {
+                if has_main_child { 0.0 } else { vm }
+            } else {
+                lateral_share * bud.q
+            };
+            if bud.enabled {
+                v_max = v_max.max(bud.vigor);
+            }
+        }
+    }
+    Some(v_max)
+}
+
 /// Step 7: lateral branches (born before this iteration) whose vigor per internode, with vigor in
 /// new internodes (v·n_max/v_max), is below Th.
 pub(crate) fn select_shed(tree: &Tree, scratch: &mut Scratch, v_max: f32) -> Vec<NodeId> {
@@ -128,4 +266,58 @@ pub(crate) fn select_shed(tree: &Tree, scratch: &mut Scratch, v_max: f32) -> Vec
         })
         .map(|c| NodeId(c as u32))
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::growth::{StepOptions, buds, light, space, timing};
+    use crate::species::Species;
+
+    #[test]
+    fn the_pass_along_the_enabled_buds_paths_gives_every_bud_the_vigor_of_the_whole_pass() {
+        let species = Species::by_name("maple").expect("maple preset");
+        let mut tree = Tree::new(species, 4);
+        tree.grow(8, None);
+        // A brush dab at the highest tip: a few buds near it win points.
+        let perception = space::radii(&tree).1;
+        let top = tree
+            .skeleton
+            .internodes
+            .iter()
+            .map(|n| n.end)
+            .max_by(|a, b| a.y.total_cmp(&b.y))
+            .expect("a tree has internodes");
+        let mut rng = crate::rng::Rng::new(2);
+        for _ in 0..40 {
+            tree.environment
+                .attraction
+                .add_persistent(top + rng.in_unit_ball() * perception);
+        }
+        tree.iteration += 1;
+        let mut scratch = Scratch::default();
+        let options = StepOptions {
+            autonomous: false,
+            scene: None,
+        };
+        buds::collect(&mut tree, &mut scratch);
+        let mut clock = timing::PhaseClock::start();
+        space::colonize(&mut tree, &mut scratch, options, &mut clock);
+        let enabled = light::bud_input(&tree, &mut scratch);
+        assert!(enabled > 0, "no bud enabled");
+        let mut along = scratch.buds.clone();
+        let v_along = distribute_along_paths(&tree, &mut scratch).expect("the paths pass runs");
+        std::mem::swap(&mut along, &mut scratch.buds);
+        let v_all = distribute(&tree, &mut scratch, true);
+        assert_eq!(v_along.to_bits(), v_all.to_bits());
+        assert!(v_all > 0.0);
+        for (a, b) in along.iter().zip(&scratch.buds) {
+            assert_eq!(
+                a.vigor.to_bits(),
+                b.vigor.to_bits(),
+                "bud of node {}",
+                a.node
+            );
+        }
+    }
 }

@@ -69,9 +69,11 @@ pub(crate) fn update(
     let n = nodes.len();
     exponents.clear();
     exponents.resize(n, default_exponent);
+    scratch.widths_of = None;
     // Without width constraints (the usual case) the whole tree is the root's subtree with the
     // species exponent: one basipetal pass, given up at the first constrained internode.
     if basipetal(nodes, None, exponents, tip_diameter, &mut scratch.acc) {
+        scratch.widths_of = Some(WidthsOf::new(n, tip_diameter, default_exponent));
         return;
     }
     let roots = &mut scratch.subtree_root;
@@ -92,6 +94,115 @@ pub(crate) fn update(
         tip_diameter,
         &mut scratch.acc,
     );
+}
+
+/// What `Scratch::acc` holds the sums of: an arena of `len` internodes without width
+/// constraints, at these tip diameter and exponent (bits), as the last width update left it.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(crate) struct WidthsOf {
+    len: usize,
+    tip_diameter: u32,
+    exponent: u32,
+}
+
+impl WidthsOf {
+    fn new(len: usize, tip_diameter: f32, exponent: f32) -> Self {
+        WidthsOf {
+            len,
+            tip_diameter: tip_diameter.to_bits(),
+            exponent: exponent.to_bits(),
+        }
+    }
+}
+
+/// New internodes per old one above which [`update_after_growth`] is not tried.
+const PATH_UPDATE_FRACTION: usize = 8;
+
+/// [`update`] after internodes were only appended to an arena of `num_before` internodes
+/// (no internode removed, no link or constraint changed among the old ones) whose widths the
+/// last update computed: only the new internodes and their ancestors change, and they are
+/// recomputed from the kept sums, in the same descending order and with the same sums as the
+/// whole pass (a node's sum adds its children's masses from the highest index down, as the
+/// reverse loop does), so every diameter comes out bit for bit the same. False, having
+/// changed nothing, when the kept sums do not describe the arena or the paths would cover
+/// too much of it (the caller then runs [`update`]).
+pub(crate) fn update_after_growth(
+    skeleton: &mut Skeleton,
+    tip_diameter: f32,
+    default_exponent: f32,
+    exponents: &mut Vec<f32>,
+    scratch: &mut Scratch,
+    num_before: usize,
+) -> bool {
+    let nodes = &mut skeleton.internodes;
+    let n = nodes.len();
+    if scratch.widths_of != Some(WidthsOf::new(num_before, tip_diameter, default_exponent))
+        || scratch.acc.len() != num_before
+        || exponents.len() != num_before
+        || num_before == 0
+        || n < num_before
+        || (n - num_before).saturating_mul(PATH_UPDATE_FRACTION) > num_before
+    {
+        return false;
+    }
+    // The old ancestors of the new internodes, each once.
+    let (marked, dirty) = (&mut scratch.on_path, &mut scratch.path_nodes);
+    marked.clear();
+    marked.resize(num_before, false);
+    dirty.clear();
+    let limit = num_before / 4;
+    for i in num_before..n {
+        let mut node = nodes[i].parent.map(|p| p.index());
+        while let Some(p) = node {
+            if p >= num_before || marked[p] {
+                break;
+            }
+            marked[p] = true;
+            dirty.push(p as u32);
+            node = nodes[p].parent.map(|q| q.index());
+        }
+        if dirty.len() > limit {
+            return false;
+        }
+    }
+    let constrained = |i: usize| nodes[i].width_constraint.is_some();
+    if (num_before..n).any(constrained) || dirty.iter().any(|&i| constrained(i as usize)) {
+        return false;
+    }
+    dirty.sort_unstable_by(|a, b| b.cmp(a));
+    exponents.resize(n, default_exponent);
+    let acc = &mut scratch.acc;
+    acc.resize(n, 0.0);
+    let exponent = f64::from(default_exponent);
+    let tip_mass = f64::from(tip_diameter).powf(exponent);
+    let new_nodes = (num_before..n).rev();
+    for i in new_nodes.chain(dirty.iter().map(|&i| i as usize)) {
+        // The children's masses, highest index first (the order the reverse pass adds them).
+        let mut children: smallvec::SmallVec<[u32; 4]> = nodes[i].children().map(|c| c.0).collect();
+        children.sort_unstable_by(|a, b| b.cmp(a));
+        let mut sum = 0.0f64;
+        for &c in &children {
+            let child = &nodes[c as usize];
+            sum += if child.is_tip() {
+                tip_mass
+            } else {
+                acc[c as usize]
+            };
+        }
+        let node = &nodes[i];
+        let diameter = if node.is_tip() {
+            tip_diameter
+        } else {
+            match (node.main_child, node.lateral_children.is_empty()) {
+                (Some(c), true) if !nodes[c.index()].is_tip() => nodes[c.index()].diameter,
+                _ => sum.powf(1.0 / exponent) as f32,
+            }
+        };
+        acc[i] = sum;
+        nodes[i].diameter = diameter;
+    }
+    scratch.widths_of = Some(WidthsOf::new(n, tip_diameter, default_exponent));
+    true
 }
 
 /// The basipetal pass: acc[i] = Σ over children of d_c^{n_i}; d_i = acc^{1/n_i}. `roots` gives
