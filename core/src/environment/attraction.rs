@@ -436,7 +436,13 @@ mod tests {
         stroke(&mut points, 1.0, 20, iteration);
         let long = stroke(&mut points, 2.0, 2000, iteration);
         // The tree grows along the long stroke: one of its points every 5 iterations.
-        let every_fifth = |i: u32| if i % 5 == 0 { vec![2.0] } else { vec![] };
+        let every_fifth = |i: u32| {
+            if i.is_multiple_of(5) {
+                vec![2.0]
+            } else {
+                vec![]
+            }
+        };
         for _ in 0..IDLE_LIFETIME_ITERATIONS - 1 {
             let eat = every_fifth(iteration);
             assert_eq!(iterate(&mut points, &mut iteration, &eat), 0);
