@@ -51,6 +51,18 @@ fn resident_bytes() -> usize {
         .map_or(0, |pages| pages * 4096)
 }
 
+/// Resident anonymous memory (heap, stacks: what the process allocated, not the pages of its
+/// binary that running new code paths maps in), bytes (0 where `/proc` is missing).
+fn resident_anonymous_bytes() -> usize {
+    std::fs::read_to_string("/proc/self/status")
+        .ok()
+        .and_then(|s| {
+            let line = s.lines().find(|l| l.starts_with("RssAnon:"))?;
+            line.split_whitespace().nth(1)?.parse::<usize>().ok()
+        })
+        .map_or(0, |kib| kib * 1024)
+}
+
 fn mib(bytes: usize) -> f64 {
     bytes as f64 / (1024.0 * 1024.0)
 }
@@ -79,6 +91,7 @@ fn main() {
     design.advance_frame(Some(camera_at(0)), 0.0, 1.0 / 30.0);
     design.apply(&InputEvent::Grow { iterations: 1 });
     let resident_before = resident_bytes();
+    let anonymous_before = resident_anonymous_bytes();
     let mut peak_ratio: f64 = 0.0;
     let mut stroke_start = glam::Vec2::ZERO;
     for step in 0..steps {
@@ -127,6 +140,7 @@ fn main() {
     let elapsed_s = started.elapsed().as_secs_f64();
     let held = live_bytes() - live_before;
     let resident = resident_bytes().saturating_sub(resident_before);
+    let anonymous = resident_anonymous_bytes().saturating_sub(anonymous_before);
     let tree_bytes = tree_own_bytes(&design);
     let (undo, timeline) = design.snapshot_bytes();
     println!(
@@ -142,9 +156,27 @@ fn main() {
         resident as f64 / tree_bytes.max(1) as f64,
     );
     println!(
-        "peak_heap_ratio={peak_ratio:.2} tree_model_own_mib={:.2} tree_saved_state_mib={:.2}",
+        "design_resident_anonymous_mib={:.2} resident_anonymous_ratio={:.2}",
+        mib(anonymous),
+        anonymous as f64 / tree_bytes.max(1) as f64,
+    );
+    let attraction = &design.tree.environment.attraction;
+    println!(
+        "peak_heap_ratio={peak_ratio:.2} tree_model_own_mib={:.2} tree_saved_state_mib={:.2} persistent_points={} point_groups={}",
         mib(design.tree.own_bytes()),
-        mib(design.tree.saved_state_bytes())
+        mib(design.tree.saved_state_bytes()),
+        attraction.num_persistent(),
+        attraction.groups.len()
+    );
+    // The heap of the design's tree as it lives, its growth working memory included: what
+    // taking it out of the design (for a seedling) frees.
+    let seedling = sylva_core::Tree::new(design.tree.species.clone(), 0);
+    let tree = std::mem::replace(&mut design.tree, seedling);
+    let with_both = live_bytes();
+    drop(tree);
+    println!(
+        "tree_live_mib={:.2} (the design's tree with its growth working memory)",
+        mib(with_both - live_bytes())
     );
 }
 

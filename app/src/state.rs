@@ -14,6 +14,7 @@ use std::collections::BTreeMap;
 
 use glam::{Affine3A, Quat, Vec2, Vec3};
 use serde::{Deserialize, Serialize};
+use sylva_core::edit::brush::{grow_with_point_lifetime, step_with_point_lifetime};
 use sylva_core::edit::{
     Bend, BendSettings, BrushSettings, BrushStroke, History, OperationKind, PositionalConstraint,
     StrokeCamera, Timeline,
@@ -358,13 +359,13 @@ fn move_to_iteration(
         timeline.go_to(tree, kept)?;
         if timeline.regrows_autonomously(kept, target) {
             while tree.iteration < target {
-                tree.grow(1, scene);
+                grow_with_point_lifetime(tree, 1, scene);
             }
         }
         return Ok(());
     }
     while tree.iteration < target {
-        tree.grow(1, scene);
+        grow_with_point_lifetime(tree, 1, scene);
         timeline.keep_autonomous(tree);
     }
     Ok(())
@@ -498,10 +499,13 @@ impl DesignState {
         ) {
             Some((scene, mode)) => {
                 brush.emit(&mut self.tree);
-                self.tree.step(sylva_core::growth::StepOptions {
-                    autonomous: false,
-                    scene: Some((&scene, mode)),
-                })
+                step_with_point_lifetime(
+                    &mut self.tree,
+                    sylva_core::growth::StepOptions {
+                        autonomous: false,
+                        scene: Some((&scene, mode)),
+                    },
+                )
             }
             None => brush.iterate(&mut self.tree),
         };
@@ -856,7 +860,11 @@ impl DesignState {
             .try_normalize()
             .unwrap_or(Vec3::Z);
         let constraint = depth_m.and_then(|d| DepthConstraint::through(base, normal, d));
+        // The points the constraint drops leave their groups (which counts as activity).
+        let iteration = self.tree.iteration;
+        let tracked = self.tree.environment.attraction.track(iteration);
         self.tree.environment.set_depth_constraint(constraint);
+        self.tree.environment.attraction.age(&tracked, iteration);
         self.changed();
     }
 

@@ -11,7 +11,10 @@ mod grid;
 mod scene;
 mod shadow;
 
-pub use attraction::{AttractionPoint, AttractionPoints};
+pub use attraction::{
+    AttractionPoint, AttractionPoints, IDLE_LIFETIME_ITERATIONS, LOOSE_GROUP, PointGroup, PointRun,
+    TrackedPoints,
+};
 pub use candidates::Candidates;
 pub use grid::SpatialGrid;
 pub(crate) use grid::{clear_with_room, floor_to_ivec3};

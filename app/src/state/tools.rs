@@ -395,16 +395,25 @@ impl DesignState {
         let grown = self
             .history
             .perform(OperationKind::Lasso, &mut self.tree, |tree| {
+                let first = tree.environment.attraction.len();
                 if envelope.add_points_to(tree, count) == 0 {
                     return Err(sylva_core::edit::EditError::DegenerateLasso {
                         points: lasso.outline.len(),
                     });
                 }
+                // The fill is one group of points, with its own lifetime.
+                let iteration = tree.iteration;
+                tree.environment
+                    .attraction
+                    .group_points_from(first, iteration);
                 for _ in 0..LASSO_MAX_ITERATIONS {
-                    let stats = tree.step(StepOptions {
-                        autonomous: false,
-                        scene: Some((&scene, SceneMode::GrowInFront)),
-                    });
+                    let stats = sylva_core::edit::brush::step_with_point_lifetime(
+                        tree,
+                        StepOptions {
+                            autonomous: false,
+                            scene: Some((&scene, SceneMode::GrowInFront)),
+                        },
+                    );
                     timeline.keep(tree);
                     if stats.num_new_internodes == 0 {
                         break;

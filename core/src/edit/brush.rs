@@ -19,11 +19,17 @@
 //! tropism T of the bud it feeds) and selective growth (only the branch from a picked bud may
 //! grow). The tree's depth constraint ([`crate::environment::DepthConstraint`], appendix B)
 //! holds for brushed points too: the brush adds none outside it.
+//!
+//! Each stroke's points are one group of the tree's attraction points, which expires when the
+//! tree has not grown into it for [`crate::environment::IDLE_LIFETIME_ITERATIONS`] iterations
+//! (see [`crate::environment::AttractionPoints`]); [`step_with_point_lifetime`] is the growth
+//! iteration that ages the groups, and [`BrushStroke::iterate`] runs it.
 
 use glam::Vec3;
 
 use super::EditError;
 use super::prune::distance_to_segment;
+use crate::environment::{Scene, SceneMode};
 use crate::growth::{IterationStats, StepOptions, Tree};
 use crate::tree::NodeId;
 
@@ -155,6 +161,8 @@ pub struct BrushStroke {
     points: Vec<StrokePoint>,
     /// Stroke points already turned into attraction points (segments before this index).
     emitted: usize,
+    /// The group of the tree's attraction points this stroke adds to (from its first point).
+    group: Option<u16>,
 }
 
 impl BrushStroke {
@@ -171,6 +179,7 @@ impl BrushStroke {
             settings,
             points: Vec::new(),
             emitted: 0,
+            group: None,
         })
     }
 
@@ -252,23 +261,32 @@ impl BrushStroke {
 
     /// Points in the ball under the brush where it rests now (the brush keeps painting while
     /// the finger stays down without moving). Returns how many were added.
-    pub fn emit_dab(&self, tree: &mut Tree) -> usize {
+    pub fn emit_dab(&mut self, tree: &mut Tree) -> usize {
         match self.points.last() {
             Some(&p) => self.fill_segment(tree, p, p, tree.species.internode_length_m),
             None => 0,
         }
     }
 
-    /// Emits the new part of the stroke and runs one brush-guided growth iteration.
+    /// Emits the new part of the stroke and runs one brush-guided growth iteration (ageing the
+    /// attraction points' groups, [`step_with_point_lifetime`]).
     pub fn iterate(&mut self, tree: &mut Tree) -> IterationStats {
         self.emit(tree);
-        tree.step(StepOptions {
-            autonomous: false,
-            scene: None,
-        })
+        step_with_point_lifetime(
+            tree,
+            StepOptions {
+                autonomous: false,
+                scene: None,
+            },
+        )
     }
 
-    fn fill_segment(&self, tree: &mut Tree, a: StrokePoint, b: StrokePoint, l: f32) -> usize {
+    /// The group of the tree's attraction points this stroke adds to, once it added one.
+    pub fn group(&self) -> Option<u16> {
+        self.group
+    }
+
+    fn fill_segment(&mut self, tree: &mut Tree, a: StrokePoint, b: StrokePoint, l: f32) -> usize {
         let length = a.position.distance(b.position);
         let radius = a.radius_m.max(b.radius_m);
         let swept = std::f32::consts::PI * radius * radius * length
@@ -277,6 +295,10 @@ impl BrushStroke {
         let by_volume = (swept / (l * l * l) * self.settings.points_per_internode_cube).ceil();
         let count = by_length.max(by_volume).max(1.0) as usize;
         let direction = (b.position - a.position).try_normalize();
+        let iteration = tree.iteration;
+        let group = *self
+            .group
+            .get_or_insert_with(|| tree.environment.attraction.begin_group(iteration));
         let mut added = 0;
         for _ in 0..count {
             let t = tree.rng.next_f32();
@@ -286,15 +308,17 @@ impl BrushStroke {
             if !tree.environment.depth_allows(p) {
                 continue;
             }
-            match direction.filter(|_| self.settings.sketch_tropism) {
-                Some(d) => {
-                    let attraction = &mut tree.environment.attraction;
-                    attraction.sketch_tropism_weight = self.settings.sketch_tropism_weight;
-                    attraction.add_persistent_with_tropism(p, d)
-                }
-                None => tree.environment.attraction.add_persistent(p),
+            let attraction = &mut tree.environment.attraction;
+            let tropism = direction.filter(|_| self.settings.sketch_tropism);
+            if tropism.is_some() {
+                attraction.sketch_tropism_weight = self.settings.sketch_tropism_weight;
             }
+            attraction.add_persistent_to(group, p, tropism);
             added += 1;
+        }
+        if added > 0 {
+            // Painting keeps the stroke alive.
+            tree.environment.attraction.mark_active(group, iteration);
         }
         added
     }
@@ -310,6 +334,46 @@ impl BrushStroke {
                 .fold(f32::INFINITY, f32::min),
         }
     }
+}
+
+/// One growth iteration of `tree` that ages its groups of persistent attraction points: a group
+/// that lost no point and gained none for [`crate::environment::IDLE_LIFETIME_ITERATIONS`]
+/// iterations expires ([`crate::environment::AttractionPoints::track`] and
+/// [`crate::environment::AttractionPoints::age`] around [`Tree::step`]). Every growth iteration
+/// of a design (brush, lasso, whole-tree growth) runs through it, so that unreached strokes do
+/// not pile up.
+pub fn step_with_point_lifetime(tree: &mut Tree, options: StepOptions) -> IterationStats {
+    let tracked = tree.environment.attraction.track(tree.iteration);
+    let stats = tree.step(options);
+    tree.environment.attraction.age(&tracked, tree.iteration);
+    stats
+}
+
+/// `iterations` autonomous growth iterations, each [`step_with_point_lifetime`] (what
+/// [`Tree::grow`] does, with the points' lifetime).
+pub fn grow_with_point_lifetime(
+    tree: &mut Tree,
+    iterations: u32,
+    scene: Option<(&dyn Scene, SceneMode)>,
+) -> IterationStats {
+    let mut total = IterationStats::default();
+    for _ in 0..iterations {
+        let s = step_with_point_lifetime(
+            tree,
+            StepOptions {
+                autonomous: true,
+                scene,
+            },
+        );
+        total.num_buds = s.num_buds;
+        total.num_enabled_buds += s.num_enabled_buds;
+        total.num_points += s.num_points;
+        total.num_shoots += s.num_shoots;
+        total.num_new_internodes += s.num_new_internodes;
+        total.num_shed_internodes += s.num_shed_internodes;
+        total.num_pruned_internodes += s.num_pruned_internodes;
+    }
+    total
 }
 
 /// Selective growth (§5.2.4): the living bud nearest `pick` is re-oriented along the stroke's
@@ -358,4 +422,86 @@ pub fn begin_selective_growth(
 /// Leaves selective growth: every bud may grow again.
 pub fn end_selective_growth(tree: &mut Tree) {
     tree.growth_mask = None;
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::environment::IDLE_LIFETIME_ITERATIONS;
+    use crate::species::Species;
+
+    fn oak() -> Tree {
+        Tree::new(Species::by_name("oak").expect("oak preset"), 0x5EED_0021)
+    }
+
+    /// A stroke on the plane z = 0, drawn from a still camera 4 m in front of it.
+    fn still_stroke() -> (StrokeCamera, BrushStroke) {
+        let plane = BrushPlane::new(Vec3::ZERO, Vec3::Z).expect("plane");
+        (
+            StrokeCamera::facing(plane, 4.0).expect("camera"),
+            BrushStroke::new(4.0, BrushSettings::default()).expect("stroke"),
+        )
+    }
+
+    #[test]
+    fn a_stroke_no_bud_reaches_expires_after_the_lifetime() {
+        let mut tree = oak();
+        tree.grow(2, None);
+        let (camera, mut stroke) = still_stroke();
+        stroke
+            .add_point(0.0, camera, Vec3::new(6.0, 4.0, 0.0), 0.1)
+            .expect("point");
+        stroke.iterate(&mut tree);
+        let attraction = &tree.environment.attraction;
+        let painted = attraction.num_persistent();
+        assert!(painted > 0);
+        assert_eq!(attraction.groups.len(), 1);
+        assert_eq!(Some(attraction.groups[0].id), stroke.group());
+        for _ in 2..IDLE_LIFETIME_ITERATIONS {
+            stroke.iterate(&mut tree);
+        }
+        assert_eq!(
+            tree.environment.attraction.num_persistent(),
+            painted,
+            "idle for one iteration less than the lifetime"
+        );
+        stroke.iterate(&mut tree);
+        let attraction = &tree.environment.attraction;
+        assert_eq!(attraction.num_persistent(), 0, "expired");
+        assert!(attraction.runs.is_empty() && attraction.groups.is_empty());
+        tree.sanity_check().expect("sane");
+    }
+
+    #[test]
+    fn a_stroke_from_a_tip_is_consumed_as_the_tree_grows_along_it() {
+        let mut tree = oak();
+        let l = tree.species.internode_length_m;
+        let tip = tree.skeleton.internodes[0].end;
+        let end = tip + Vec3::new(0.3 * 30.0 * l, 30.0 * l, 0.0);
+        let (camera, mut stroke) = still_stroke();
+        // The whole sketch at once: later points are reached only through the earlier ones.
+        for k in 0..=30 {
+            let p = tip.lerp(end, k as f32 / 30.0);
+            stroke.add_point(0.0, camera, p, 0.0).expect("point");
+        }
+        stroke.emit(&mut tree);
+        let painted = tree.environment.attraction.num_persistent();
+        let mut iterations = 0;
+        while tree.environment.attraction.num_persistent() > 0 && iterations < 400 {
+            stroke.iterate(&mut tree);
+            iterations += 1;
+        }
+        let reach = tree
+            .skeleton
+            .internodes
+            .iter()
+            .map(|n| n.end.distance(end))
+            .fold(f32::INFINITY, f32::min);
+        println!(
+            "{painted} points consumed in {iterations} iterations; the tree ends {reach:.3} m from the stroke's end"
+        );
+        assert!(reach <= 2.0 * l, "the tree stopped {reach} m from the end");
+        assert_eq!(tree.environment.attraction.num_persistent(), 0);
+        tree.sanity_check().expect("sane");
+    }
 }
