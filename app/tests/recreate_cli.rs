@@ -51,6 +51,7 @@ struct Run {
     line: String,
     report: Value,
     silhouettes: PathBuf,
+    crown: PathBuf,
 }
 
 fn recreate(dir: &Path, footage: &Path, marks: &Path, extra: &[&str]) -> Run {
@@ -58,6 +59,7 @@ fn recreate(dir: &Path, footage: &Path, marks: &Path, extra: &[&str]) -> Run {
     let report = dir.join("report.json");
     let glb = dir.join("tree.glb");
     let silhouettes = dir.join("silhouettes");
+    let crown = dir.join("crown");
     let mut args = vec![
         "recreate",
         footage.to_str().expect("utf-8"),
@@ -71,6 +73,8 @@ fn recreate(dir: &Path, footage: &Path, marks: &Path, extra: &[&str]) -> Run {
         report.to_str().expect("utf-8"),
         "--silhouettes",
         silhouettes.to_str().expect("utf-8"),
+        "--crown-masks",
+        crown.to_str().expect("utf-8"),
     ];
     args.extend_from_slice(extra);
     let output = sylva(&args);
@@ -88,6 +92,7 @@ fn recreate(dir: &Path, footage: &Path, marks: &Path, extra: &[&str]) -> Run {
         line,
         report,
         silhouettes,
+        crown,
     }
 }
 
@@ -132,11 +137,46 @@ fn mean_iou(run: &Run, footage: &Path, frames: &[usize]) -> f64 {
             false_positive += (m && !t) as usize;
         }
         let iou = both as f64 / either.max(1) as f64;
+        if std::env::var_os("SYLVA_RECREATE_KEEP").is_some() {
+            // Where the pixels are lost, to look at: white on both, red only on the model
+            // (false positive), blue only on the true mask (false negative).
+            let colours: Vec<u8> = (truth.pixels.iter().zip(&model))
+                .flat_map(|(t, m)| match (*t > 0, *m > 0) {
+                    (true, true) => [255, 255, 255],
+                    (false, true) => [230, 40, 40],
+                    (true, false) => [40, 90, 230],
+                    (false, false) => [0, 0, 0],
+                })
+                .collect();
+            let path = run.silhouettes.join(format!("compare-{f:05}.png"));
+            image::save_buffer(
+                &path,
+                &colours,
+                truth.width as u32,
+                truth.height as u32,
+                image::ColorType::Rgb8,
+            )
+            .expect("comparison image");
+        }
         println!(
             "  {} frame {f}: IoU {iou:.3} ({both} px on both, {false_positive} false positive, {} false negative)",
             footage.file_name().and_then(|n| n.to_str()).unwrap_or("?"),
             either - both - false_positive
         );
+        // The crown as segmented in that frame, when it was, against the true foliage.
+        if let Ok(segmented) = image::open(run.crown.join(format!("{f:05}.png"))) {
+            let segmented = segmented.to_luma8().into_raw();
+            let (mut both, mut either) = (0usize, 0usize);
+            for (t, m) in truth.pixels.iter().zip(&segmented) {
+                let (t, m) = (*t == 255, *m > 0);
+                both += (t && m) as usize;
+                either += (t || m) as usize;
+            }
+            println!(
+                "    segmented crown: IoU {:.3} with the true foliage",
+                both as f64 / either.max(1) as f64
+            );
+        }
         sum += iou;
     }
     sum / frames.len() as f64

@@ -61,6 +61,10 @@ pub struct GrowthReport {
     pub crown_voxels: Option<usize>,
     /// The foliage fitted to the crown's silhouettes ([`super::fit`]).
     pub foliage: Option<super::fit::FoliageFit>,
+    /// The real trunk as the footage shows it ([`super::trunk`]), and the factor the model's
+    /// widths were scaled by to match its diameter.
+    pub trunk: Option<super::trunk::TrunkFound>,
+    pub trunk_width_ratio: Option<f32>,
 }
 
 /// Leaf cards reach about this far beyond the twigs that carry them (m): the envelope growth
@@ -482,6 +486,8 @@ pub fn grow_into_hull(
         segmented_views: 0,
         crown_voxels: None,
         foliage,
+        trunk: None,
+        trunk_width_ratio: None,
     };
     (tree, world_from_tree, report)
 }
