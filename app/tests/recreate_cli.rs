@@ -323,12 +323,14 @@ fn tree_b_in_front_of_a_wall_from_two_outlines_measures_height_width_and_crown_b
 }
 
 /// The targets are IoU 0.80 in the marked views and 0.70 in the others. With the crown
-/// segmented in the footage and the foliage fitted to it the model (leaf cards alpha-tested, as
-/// drawn) reaches 0.62-0.64 marked and 0.60-0.65 unmarked; its leaves fringe the real crown's
-/// lobes, its trunk is thinner than the real one. Until the targets hold this guards what holds:
-/// a floor a little under today's.
-const MIN_IOU_MARKED: f64 = 0.60;
-const MIN_IOU_UNMARKED: f64 = 0.58;
+/// segmented in the footage, the trunk found in it (the base moved onto it, the model's widths
+/// scaled to its diameter) and the foliage fitted to the crown's views, the model (leaf cards
+/// alpha-tested, as drawn) reaches 0.69-0.72 marked and 0.71-0.74 unmarked; its leaf cards
+/// still fringe the crown's lobes and it misses some low lobes. Until the marked target holds
+/// this guards what holds: a floor a little under today's (growth is chaotic: a millimetre's
+/// change of the base moves these by ±0.03).
+const MIN_IOU_MARKED: f64 = 0.66;
+const MIN_IOU_UNMARKED: f64 = 0.67;
 
 fn check_iou(name: &str, marked: f64, unmarked: f64) {
     assert!(

@@ -81,6 +81,8 @@ const MIN_GAIN: f32 = 0.005;
 const GAIN_WINDOW: usize = 5;
 /// With a coverage score, growth stops after this many iterations without a better one.
 const COVER_WINDOW: usize = 4;
+/// The leafy threshold is this fraction of the trunk's diameter at the crown base.
+const BARE_MARGIN: f32 = 0.99;
 /// Shoots are trimmed to end at most this many voxels inside the crown's surface.
 const TRIM_VOXELS: usize = 3;
 
@@ -303,7 +305,10 @@ pub fn bare_trunk(tree: &mut Tree, crown_base_m: f32, leafy_diameters: f32) {
     };
     let tip = tree.species.tip_diameter_m.max(1e-4);
     let mut looks = tree.species.looks().clone();
-    looks.leafy_diameters = (at_base / tip).clamp(1.0, leafy_diameters.max(1.0));
+    // A little under the trunk's own: the trunk below the crown base is as thick as there (no
+    // branch joins it), and rounding must not put it under the threshold when the widths are
+    // scaled later ([`super::trunk::fit_trunk_diameter`]).
+    looks.leafy_diameters = (at_base / tip * BARE_MARGIN).clamp(1.0, leafy_diameters.max(1.0));
     tree.species.looks = Some(looks);
 }
 

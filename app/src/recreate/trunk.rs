@@ -305,3 +305,66 @@ pub fn fit_trunk_diameter(tree: &mut sylva_core::Tree, diameter_m: f64, height_m
     tree.update_widths();
     ratio
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_bark_strip_beside_the_projected_axis_is_found_with_its_offset_and_width() {
+        // Grass, speckled; a bark strip 13 px wide at x = 100..=112; the axis projected at x = 95.
+        let image = image::RgbImage::from_fn(200, 120, |x, y| {
+            let n = ((x * 7 + y * 13) % 9) as u8;
+            if (100..=112).contains(&x) {
+                image::Rgb([110 + n, 90 + n, 70 + n])
+            } else {
+                image::Rgb([60 + n, 140 + 2 * n, 40 + n])
+            }
+        });
+        // 100 px per metre across, rows down the image.
+        let view = ViewRows {
+            across: DVec3::X,
+            rows: (0..ROWS)
+                .map(|r| (DVec2::new(95.0, 10.0 + 6.0 * r as f64), DVec2::X, 100.0))
+                .collect(),
+        };
+        let bark: Vec<image::Rgb<u8>> = (0..120)
+            .flat_map(|y| (103..110).map(move |x| (x, y)))
+            .map(|(x, y)| *image.get_pixel(x, y))
+            .collect();
+        let trunk = ColourModel::of_samples(bark.into_iter()).expect("bark colours");
+        let (offset, width) = trunk_in_view(&image, &view, &trunk).expect("the strip");
+        assert!((offset - 0.11).abs() < 0.011, "offset {offset} m");
+        assert!((width - 0.13).abs() < 0.011, "width {width} m");
+    }
+
+    #[test]
+    fn without_a_strip_no_trunk_is_found() {
+        let image = image::RgbImage::from_fn(200, 120, |x, y| {
+            let n = ((x * 7 + y * 13) % 9) as u8;
+            image::Rgb([60 + n, 140 + 2 * n, 40 + n])
+        });
+        let view = ViewRows {
+            across: DVec3::X,
+            rows: (0..ROWS)
+                .map(|r| (DVec2::new(95.0, 10.0 + 6.0 * r as f64), DVec2::X, 100.0))
+                .collect(),
+        };
+        let bark = (0..50).map(|i| image::Rgb([110 + (i % 9) as u8, 90, 70]));
+        let trunk = ColourModel::of_samples(bark).expect("bark colours");
+        assert!(trunk_in_view(&image, &view, &trunk).is_none());
+    }
+
+    #[test]
+    fn the_fitted_trunk_has_the_measured_diameter_and_the_twigs_keep_their_proportion() {
+        let species = sylva_core::species::Species::by_name("birch").expect("birch preset");
+        let mut tree = sylva_core::Tree::new(species, 4);
+        tree.grow_years(6.0);
+        let before = tree.trunk_diameter_at(0.5).expect("a trunk at 0.5 m");
+        let ratio = fit_trunk_diameter(&mut tree, 2.0 * before as f64, 0.5);
+        let after = tree.trunk_diameter_at(0.5).expect("a trunk at 0.5 m");
+        assert!((ratio - 2.0).abs() < 1e-3, "ratio {ratio}");
+        assert!((after / before - 2.0).abs() < 1e-3, "{before} m -> {after} m");
+        assert!(tree.sanity_check().is_ok());
+    }
+}
