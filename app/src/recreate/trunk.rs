@@ -364,7 +364,10 @@ mod tests {
         let ratio = fit_trunk_diameter(&mut tree, 2.0 * before as f64, 0.5);
         let after = tree.trunk_diameter_at(0.5).expect("a trunk at 0.5 m");
         assert!((ratio - 2.0).abs() < 1e-3, "ratio {ratio}");
-        assert!((after / before - 2.0).abs() < 1e-3, "{before} m -> {after} m");
+        assert!(
+            (after / before - 2.0).abs() < 1e-3,
+            "{before} m -> {after} m"
+        );
         assert!(tree.sanity_check().is_ok());
     }
 }
