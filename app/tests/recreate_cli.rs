@@ -297,6 +297,10 @@ fn prune_a_main_limb_and_grow_ten_years(tree_file: &Path) {
         gap.len()
     );
     assert!(
+        regrown_n > after_cut,
+        "the gap holds no more after 10 years ({regrown_n}) than right after the cut ({after_cut})"
+    );
+    assert!(
         new_in_gap * 4 >= gap.len(),
         "no regrowth into the gap: {new_in_gap} internodes grew there in 10 years after cutting a limb of {}",
         gap.len()
@@ -320,6 +324,7 @@ fn tree_b_in_front_of_a_wall_from_two_outlines_measures_height_width_and_crown_b
         "tree_b: IoU against the true masks: marked views {marked:.3}, unmarked {unmarked:.3}"
     );
     check_iou("tree_b", marked, unmarked);
+    prune_a_main_limb_and_grow_ten_years(&dir.join("tree.json"));
 }
 
 /// The targets are IoU 0.80 in the marked views and 0.70 in the others. With the crown

@@ -27,6 +27,8 @@ pub struct FoliageFit {
     pub density_scale: f32,
     /// Shoots end at least this many hull voxels inside the crown's surface.
     pub trim_voxels: usize,
+    /// The fitted foliage's mean IoU with each trim tried (0, 1, ... voxels inside).
+    pub trim_iou: Vec<f64>,
     /// Mean IoU of the foliage with the targets, the species' own foliage and the fitted.
     pub iou_before: f64,
     pub iou_after: f64,
@@ -93,6 +95,18 @@ fn with_foliage(tree: &Tree, length: f32, width: f32, per_metre: f32) -> Tree {
 /// neither does: smaller leaves, denser, fringe the crown's outline less than large ones filling
 /// the same area, and the best balance differs from crown to crown.
 pub fn fit_foliage(tree: &Tree, score: &dyn Fn(&Tree) -> f64) -> (Tree, FoliageFit) {
+    fit_foliage_from(tree, score, None)
+}
+
+/// [`fit_foliage`], the descent starting at `start` (a leaf size and density the fit chose for a
+/// like tree: the same tree trimmed a little differently) instead of the species' own, so it
+/// ends in a few scores when the optimum barely moved. The species' own is still scored, for
+/// [`FoliageFit::iou_before`].
+pub fn fit_foliage_from(
+    tree: &Tree,
+    score: &dyn Fn(&Tree) -> f64,
+    start: Option<&FoliageFit>,
+) -> (Tree, FoliageFit) {
     let looks = tree.species.looks().clone();
     let scaled = |(leaf, density): (usize, usize)| {
         let (leaf, density) = (LEAF_SCALES[leaf], DENSITY_SCALES[density]);
@@ -114,7 +128,16 @@ pub fn fit_foliage(tree: &Tree, score: &dyn Fn(&Tree) -> f64) -> (Tree, FoliageF
         })
     };
     let before = rate(OWN);
-    let (mut at, mut best) = (OWN, before);
+    let index_of = |scales: &[f32], v: f32| scales.iter().position(|&s| s == v);
+    let first = start
+        .and_then(|f| {
+            Some((
+                index_of(&LEAF_SCALES, f.leaf_scale)?,
+                index_of(&DENSITY_SCALES, f.density_scale)?,
+            ))
+        })
+        .unwrap_or(OWN);
+    let (mut at, mut best) = (first, rate(first));
     loop {
         let mut moved = false;
         for axis in 0..2 {
@@ -145,6 +168,7 @@ pub fn fit_foliage(tree: &Tree, score: &dyn Fn(&Tree) -> f64) -> (Tree, FoliageF
         leaf_scale: LEAF_SCALES[at.0],
         density_scale: DENSITY_SCALES[at.1],
         trim_voxels: 0,
+        trim_iou: Vec::new(),
         iou_before: before,
         iou_after: best,
     };

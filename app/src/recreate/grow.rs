@@ -15,7 +15,7 @@ use sylva_core::environment::{Scene, SceneMode};
 use sylva_core::growth::StepOptions;
 use sylva_core::species::Species;
 
-use super::fit::{FoliageFit, fit_foliage};
+use super::fit::{FoliageFit, fit_foliage, fit_foliage_from};
 use super::hull::Hull;
 use super::measure::Recreation;
 
@@ -85,6 +85,10 @@ const COVER_WINDOW: usize = 4;
 const BARE_MARGIN: f32 = 0.99;
 /// Shoots are trimmed to end at most this many voxels inside the crown's surface.
 const TRIM_VOXELS: usize = 3;
+/// The shallowest trim whose views' mean IoU is within this of the best trim's is kept: a deeper
+/// one must gain more than this (half a percent of IoU, the size of the differences the views'
+/// pixel sampling and the leaves' random placement make between like trees) to cut more.
+const TRIM_TOLERANCE: f64 = 0.005;
 
 /// Scores a grown tree (its widths updated, the trunk bare) against the crown's views.
 pub type Coverage<'a> = &'a (dyn Fn(&Tree) -> f64 + Sync);
@@ -452,20 +456,33 @@ pub fn grow_into_hull(
     let mut foliage = None;
     tree = match (crown, coverage) {
         (Some(crown), Some(coverage)) => {
-            let mut fitted: Option<(Tree, FoliageFit)> = None;
+            // Each trim's foliage is fitted from the untrimmed one's choice (a few scores when
+            // it barely moves). Among trims scoring about the same, the one that cuts least is
+            // kept: a deeper trim takes living shoots (and the buds that would regrow the
+            // crown after a cut), so it must earn that by a clearly better agreement.
+            let mut tried: Vec<(Tree, FoliageFit)> = Vec::new();
             for k in 0..=TRIM_VOXELS {
                 let shrunk = crown.eroded(k as f64 * crown.voxel_m);
                 let inside =
                     |p: Vec3| shrunk.contains(world_from_tree.transform_point3(p).as_dvec3(), 0);
-                let (candidate, mut fit) = fit_foliage(&finish(&tree, &inside), coverage);
+                let start = tried.first().map(|(_, f)| f);
+                let (candidate, mut fit) =
+                    fit_foliage_from(&finish(&tree, &inside), coverage, start);
                 fit.trim_voxels = k;
-                if fitted
-                    .as_ref()
-                    .is_none_or(|(_, b)| fit.iou_after > b.iou_after)
-                {
-                    fitted = Some((candidate, fit));
-                }
+                tried.push((candidate, fit));
             }
+            let top = tried
+                .iter()
+                .map(|(_, f)| f.iou_after)
+                .fold(f64::NEG_INFINITY, f64::max);
+            let trim_iou: Vec<f64> = tried.iter().map(|(_, f)| f.iou_after).collect();
+            let fitted = tried
+                .into_iter()
+                .find(|(_, f)| f.iou_after >= top - TRIM_TOLERANCE)
+                .map(|(t, mut f)| {
+                    f.trim_iou = trim_iou;
+                    (t, f)
+                });
             match fitted {
                 Some((fitted, fit)) => {
                     foliage = Some(fit);
