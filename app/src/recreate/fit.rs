@@ -174,3 +174,41 @@ pub fn fit_foliage_from(
     };
     (scaled(at), fit)
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::cell::Cell;
+
+    /// A score peaked at one leaf size and density of the scales (concave along each).
+    fn peaked(own: &sylva_core::geometry::Looks, leaf: f32, density: f32) -> impl Fn(&Tree) -> f64 {
+        let (length, per_metre) = (own.leaf_length, own.leaves_per_metre);
+        move |t: &Tree| {
+            let l = t.species.looks();
+            let a = (l.leaf_length / (length * leaf)).ln();
+            let b = (l.leaves_per_metre / (per_metre * density)).ln();
+            1.0 - f64::from(a * a + b * b)
+        }
+    }
+
+    #[test]
+    fn the_descent_finds_the_peak_and_a_warm_start_there_needs_few_scores() {
+        let tree = Tree::new(sylva_core::species::Species::presets().remove(0), 3);
+        let score = peaked(tree.species.looks(), 0.63, 6.4);
+        let calls = Cell::new(0);
+        let counted = |t: &Tree| {
+            calls.set(calls.get() + 1);
+            score(t)
+        };
+        let (_, cold) = fit_foliage(&tree, &counted);
+        assert_eq!((cold.leaf_scale, cold.density_scale), (0.63, 6.4));
+        let cold_calls = calls.replace(0);
+        let (fitted, warm) = fit_foliage_from(&tree, &counted, Some(&cold));
+        assert_eq!((warm.leaf_scale, warm.density_scale), (0.63, 6.4));
+        assert_eq!(warm.iou_before, cold.iou_before);
+        assert!((score(&fitted) - warm.iou_after).abs() < 1e-12);
+        // The species' own, the start and its four neighbours.
+        assert_eq!(calls.get(), 6, "{cold_calls} scores cold");
+        assert!(calls.get() < cold_calls);
+    }
+}

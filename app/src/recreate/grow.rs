@@ -316,6 +316,17 @@ pub fn bare_trunk(tree: &mut Tree, crown_base_m: f32, leafy_diameters: f32) {
     tree.species.looks = Some(looks);
 }
 
+/// The first of `scores` (shallowest trim first) within `tolerance` of the best; None when empty
+/// or none is a number.
+fn shallowest_near_best(scores: &[f64], tolerance: f64) -> Option<usize> {
+    let top = scores
+        .iter()
+        .copied()
+        .filter(|s| !s.is_nan())
+        .fold(f64::NEG_INFINITY, f64::max);
+    scores.iter().position(|&s| s >= top - tolerance)
+}
+
 /// Grows `species` into the recreation's hull; `max_years` bounds the growth. `guide.crown`, when
 /// given, is the crown's own volume inside the hull (the hull carved again by the segmented
 /// silhouettes, [`super::segment`]): the attraction points fill it, and the fill is measured
@@ -471,18 +482,12 @@ pub fn grow_into_hull(
                 fit.trim_voxels = k;
                 tried.push((candidate, fit));
             }
-            let top = tried
-                .iter()
-                .map(|(_, f)| f.iou_after)
-                .fold(f64::NEG_INFINITY, f64::max);
             let trim_iou: Vec<f64> = tried.iter().map(|(_, f)| f.iou_after).collect();
-            let fitted = tried
-                .into_iter()
-                .find(|(_, f)| f.iou_after >= top - TRIM_TOLERANCE)
-                .map(|(t, mut f)| {
-                    f.trim_iou = trim_iou;
-                    (t, f)
-                });
+            let fitted = shallowest_near_best(&trim_iou, TRIM_TOLERANCE).map(|k| {
+                let (t, mut f) = tried.swap_remove(k);
+                f.trim_iou = trim_iou;
+                (t, f)
+            });
             match fitted {
                 Some((fitted, fit)) => {
                     foliage = Some(fit);
@@ -517,6 +522,18 @@ pub fn grow_into_hull(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_deeper_trim_is_kept_only_when_it_scores_clearly_better() {
+        assert_eq!(shallowest_near_best(&[0.70, 0.703, 0.704], 0.005), Some(0));
+        assert_eq!(
+            shallowest_near_best(&[0.69, 0.70, 0.715, 0.711], 0.005),
+            Some(2)
+        );
+        assert_eq!(shallowest_near_best(&[0.69, 0.712, 0.715], 0.005), Some(1));
+        assert_eq!(shallowest_near_best(&[f64::NAN, 0.6], 0.005), Some(1));
+        assert_eq!(shallowest_near_best(&[], 0.005), None);
+    }
 
     #[test]
     fn crown_lifting_leaves_one_axis_below_the_crown_base() {
