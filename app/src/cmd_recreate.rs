@@ -1,5 +1,5 @@
 //! `sylva recreate FOOTAGE --marks MARKS.json [--species S] [--holding-height-m H] --out tree.json
-//! [--glb tree.glb] [--report report.json] [--silhouettes DIR]`: tracks the footage with Sylva's
+//! [--glb tree.glb] [--report report.json] [--silhouettes DIR] [--crown-masks DIR]`: tracks the footage with Sylva's
 //! own tracker, measures the real tree from the marks ([`crate::recreate`]), grows a species into
 //! it, and ends with one line
 //! `height_m= crown_width_m= crown_base_m= tree_points= internodes= outline_iou=`
@@ -44,6 +44,9 @@ pub struct RecreateArgs {
     /// Writes the model's silhouette in every tracked frame as `DIR/NNNNN.png` (frame index).
     #[arg(long)]
     pub silhouettes: Option<PathBuf>,
+    /// Writes the crown as segmented in the footage's frames as `DIR/NNNNN.png` (frame index).
+    #[arg(long)]
+    pub crown_masks: Option<PathBuf>,
     /// Seed of the tree's random generator.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -160,6 +163,14 @@ pub fn recreate(args: RecreateArgs) -> anyhow::Result<()> {
             }
         }
     }
+    if let Some(dir) = &args.crown_masks {
+        std::fs::create_dir_all(dir).with_context(|| format!("creating {}", dir.display()))?;
+        for mask in &recreated.crown_masks {
+            let path = dir.join(format!("{:05}.png", mask.frame));
+            mask.save_png(&path)
+                .with_context(|| format!("writing {}", path.display()))?;
+        }
+    }
     let internodes = tree.skeleton.len();
     if let Some(path) = &args.report {
         let c = &footage.camera;
@@ -216,6 +227,16 @@ pub fn recreate(args: RecreateArgs) -> anyhow::Result<()> {
         println!(
             "crown: segmented in {} views, {voxels} of the hull's {} voxels kept",
             growth.segmented_views, m.hull_voxels
+        );
+    }
+    if let Some(t) = &growth.trunk {
+        println!(
+            "trunk: seen in {} views ({} agree), base moved {:.3} m, diameter {:.3} m (model's widths x{:.2})",
+            t.views,
+            t.agreeing_views,
+            t.shift_m,
+            t.diameter_m,
+            growth.trunk_width_ratio.unwrap_or(1.0)
         );
     }
     if let Some(f) = &growth.foliage {

@@ -15,7 +15,7 @@ use sylva_core::environment::{Scene, SceneMode};
 use sylva_core::growth::StepOptions;
 use sylva_core::species::Species;
 
-use super::fit::{FoliageFit, fit_foliage};
+use super::fit::{FoliageFit, fit_foliage, fit_foliage_from};
 use super::hull::Hull;
 use super::measure::Recreation;
 
@@ -61,6 +61,10 @@ pub struct GrowthReport {
     pub crown_voxels: Option<usize>,
     /// The foliage fitted to the crown's silhouettes ([`super::fit`]).
     pub foliage: Option<super::fit::FoliageFit>,
+    /// The real trunk as the footage shows it ([`super::trunk`]), and the factor the model's
+    /// widths were scaled by to match its diameter.
+    pub trunk: Option<super::trunk::TrunkFound>,
+    pub trunk_width_ratio: Option<f32>,
 }
 
 /// Leaf cards reach about this far beyond the twigs that carry them (m): the envelope growth
@@ -77,8 +81,14 @@ const MIN_GAIN: f32 = 0.005;
 const GAIN_WINDOW: usize = 5;
 /// With a coverage score, growth stops after this many iterations without a better one.
 const COVER_WINDOW: usize = 4;
+/// The leafy threshold is this fraction of the trunk's diameter at the crown base.
+const BARE_MARGIN: f32 = 0.99;
 /// Shoots are trimmed to end at most this many voxels inside the crown's surface.
 const TRIM_VOXELS: usize = 3;
+/// The shallowest trim whose views' mean IoU is within this of the best trim's is kept: a deeper
+/// one must gain more than this (half a percent of IoU, the size of the differences the views'
+/// pixel sampling and the leaves' random placement make between like trees) to cut more.
+const TRIM_TOLERANCE: f64 = 0.005;
 
 /// Scores a grown tree (its widths updated, the trunk bare) against the crown's views.
 pub type Coverage<'a> = &'a (dyn Fn(&Tree) -> f64 + Sync);
@@ -299,8 +309,22 @@ pub fn bare_trunk(tree: &mut Tree, crown_base_m: f32, leafy_diameters: f32) {
     };
     let tip = tree.species.tip_diameter_m.max(1e-4);
     let mut looks = tree.species.looks().clone();
-    looks.leafy_diameters = (at_base / tip).clamp(1.0, leafy_diameters.max(1.0));
+    // A little under the trunk's own: the trunk below the crown base is as thick as there (no
+    // branch joins it), and rounding must not put it under the threshold when the widths are
+    // scaled later ([`super::trunk::fit_trunk_diameter`]).
+    looks.leafy_diameters = (at_base / tip * BARE_MARGIN).clamp(1.0, leafy_diameters.max(1.0));
     tree.species.looks = Some(looks);
+}
+
+/// The first of `scores` (shallowest trim first) within `tolerance` of the best; None when empty
+/// or none is a number.
+fn shallowest_near_best(scores: &[f64], tolerance: f64) -> Option<usize> {
+    let top = scores
+        .iter()
+        .copied()
+        .filter(|s| !s.is_nan())
+        .fold(f64::NEG_INFINITY, f64::max);
+    scores.iter().position(|&s| s >= top - tolerance)
 }
 
 /// Grows `species` into the recreation's hull; `max_years` bounds the growth. `guide.crown`, when
@@ -443,20 +467,27 @@ pub fn grow_into_hull(
     let mut foliage = None;
     tree = match (crown, coverage) {
         (Some(crown), Some(coverage)) => {
-            let mut fitted: Option<(Tree, FoliageFit)> = None;
+            // Each trim's foliage is fitted from the untrimmed one's choice (a few scores when
+            // it barely moves). Among trims scoring about the same, the one that cuts least is
+            // kept: a deeper trim takes living shoots (and the buds that would regrow the
+            // crown after a cut), so it must earn that by a clearly better agreement.
+            let mut tried: Vec<(Tree, FoliageFit)> = Vec::new();
             for k in 0..=TRIM_VOXELS {
                 let shrunk = crown.eroded(k as f64 * crown.voxel_m);
                 let inside =
                     |p: Vec3| shrunk.contains(world_from_tree.transform_point3(p).as_dvec3(), 0);
-                let (candidate, mut fit) = fit_foliage(&finish(&tree, &inside), coverage);
+                let start = tried.first().map(|(_, f)| f);
+                let (candidate, mut fit) =
+                    fit_foliage_from(&finish(&tree, &inside), coverage, start);
                 fit.trim_voxels = k;
-                if fitted
-                    .as_ref()
-                    .is_none_or(|(_, b)| fit.iou_after > b.iou_after)
-                {
-                    fitted = Some((candidate, fit));
-                }
+                tried.push((candidate, fit));
             }
+            let trim_iou: Vec<f64> = tried.iter().map(|(_, f)| f.iou_after).collect();
+            let fitted = shallowest_near_best(&trim_iou, TRIM_TOLERANCE).map(|k| {
+                let (t, mut f) = tried.swap_remove(k);
+                f.trim_iou = trim_iou;
+                (t, f)
+            });
             match fitted {
                 Some((fitted, fit)) => {
                     foliage = Some(fit);
@@ -482,6 +513,8 @@ pub fn grow_into_hull(
         segmented_views: 0,
         crown_voxels: None,
         foliage,
+        trunk: None,
+        trunk_width_ratio: None,
     };
     (tree, world_from_tree, report)
 }
@@ -489,6 +522,18 @@ pub fn grow_into_hull(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_deeper_trim_is_kept_only_when_it_scores_clearly_better() {
+        assert_eq!(shallowest_near_best(&[0.70, 0.703, 0.704], 0.005), Some(0));
+        assert_eq!(
+            shallowest_near_best(&[0.69, 0.70, 0.715, 0.711], 0.005),
+            Some(2)
+        );
+        assert_eq!(shallowest_near_best(&[0.69, 0.712, 0.715], 0.005), Some(1));
+        assert_eq!(shallowest_near_best(&[f64::NAN, 0.6], 0.005), Some(1));
+        assert_eq!(shallowest_near_best(&[], 0.005), None);
+    }
 
     #[test]
     fn crown_lifting_leaves_one_axis_below_the_crown_base() {

@@ -14,6 +14,7 @@ pub mod measure;
 pub mod overlay;
 pub mod segment;
 pub mod silhouette;
+pub mod trunk;
 
 use glam::{Affine3A, Vec3};
 
@@ -52,6 +53,8 @@ pub struct Recreated {
     /// Intersection over union of the model's silhouette (as drawn) and each traced outline,
     /// per marked frame.
     pub outline_iou: Vec<(usize, f64)>,
+    /// The crown as segmented in the footage's frames (empty without its images).
+    pub crown_masks: Vec<segment::CrownMask>,
 }
 
 impl Recreated {
@@ -86,19 +89,36 @@ pub fn recreate(
     max_years: f32,
     images: Option<segment::FrameSource>,
 ) -> Result<Recreated, marks::MarksError> {
-    let recreation = measure::measure(footage, marks)?;
+    let mut recreation = measure::measure(footage, marks)?;
     let m = &recreation.measurements;
     let (species, choice) = match species {
         Some(s) => (s, "given".to_owned()),
         None => grow::closest_species(m.height_m, m.crown_width_m),
     };
     let marked: Vec<usize> = recreation.masks.iter().map(|mask| mask.frame).collect();
+    let frames = segment::carve_frames(footage, &marked);
     let crown_masks = images
-        .map(|load| {
-            let frames = segment::carve_frames(footage, &marked);
-            segment::segment_frames(footage, &recreation.hull, &frames, load)
-        })
+        .map(|load| segment::segment_frames(footage, &recreation.hull, &frames, load))
         .unwrap_or_default();
+    // The real trunk in those frames: where it stands (the base moves onto it) and how thick.
+    let trunk = images.and_then(|load| {
+        trunk::find_trunk(
+            footage,
+            recreation.base,
+            marks.base.frame,
+            recreation.measurements.crown_base_m,
+            &frames,
+            load,
+        )
+    });
+    if let Some(found) = &trunk {
+        recreation.base = glam::DVec3::from_array(found.base);
+        recreation.measurements.trunk_base = found.base;
+        recreation.measurements.methods.trunk_base += &format!(
+            ", moved {:.3} m onto the trunk seen in {} of {} views",
+            found.shift_m, found.agreeing_views, found.views
+        );
+    }
     // The crown's volume: the hull carved again by the segmented silhouettes, else the hull.
     let segmented = !crown_masks.is_empty();
     let crown = if segmented {
@@ -143,6 +163,12 @@ pub fn recreate(
         footage.ground.normal,
         max_years,
     );
+    let mut tree = tree;
+    if let Some(found) = &trunk {
+        let at = (0.5 * recreation.measurements.crown_base_m) as f32;
+        growth.trunk_width_ratio = Some(trunk::fit_trunk_diameter(&mut tree, found.diameter_m, at));
+    }
+    growth.trunk = trunk;
     growth.segmented_views = crown_masks.len();
     growth.crown_voxels = segmented.then(|| crown.num_voxels());
     let mut recreated = Recreated {
@@ -151,6 +177,7 @@ pub fn recreate(
         world_from_tree,
         growth,
         outline_iou: Vec::new(),
+        crown_masks,
     };
     let model =
         silhouette::WorldTriangles::of_meshes(&recreated.world_meshes(), &Affine3A::IDENTITY);

@@ -34,6 +34,17 @@ impl CrownMask {
         self.distance[y as usize * self.width as usize + x as usize] <= slack_px
     }
 
+    /// 8-bit grey PNG: 255 on the crown.
+    pub fn save_png(&self, path: &std::path::Path) -> anyhow::Result<()> {
+        let pixels: Vec<u8> = self
+            .inside
+            .iter()
+            .map(|&v| if v { 255 } else { 0 })
+            .collect();
+        image::save_buffer(path, &pixels, self.width, self.height, image::ColorType::L8)?;
+        Ok(())
+    }
+
     pub fn area_px(&self) -> usize {
         self.inside.iter().filter(|&&v| v).count()
     }
@@ -53,7 +64,7 @@ const CORE_PX: f32 = 4.0;
 const ROUNDS: usize = 3;
 
 /// A smoothed colour histogram (a density over RGB at [`LEVELS`] per channel).
-struct ColourModel {
+pub(super) struct ColourModel {
     density: Vec<f32>,
 }
 
@@ -64,13 +75,22 @@ fn bin(p: &image::Rgb<u8>) -> usize {
 
 impl ColourModel {
     fn of(image: &image::RgbImage, pick: impl Fn(usize) -> bool) -> Option<Self> {
+        Self::of_samples(
+            image
+                .pixels()
+                .enumerate()
+                .filter(|(i, _)| pick(*i))
+                .map(|(_, p)| *p),
+        )
+    }
+
+    /// The model of the colours `samples`; None without any.
+    pub(super) fn of_samples(samples: impl Iterator<Item = image::Rgb<u8>>) -> Option<Self> {
         let mut counts = vec![0.0f32; LEVELS * LEVELS * LEVELS];
         let mut total = 0usize;
-        for (i, p) in image.pixels().enumerate() {
-            if pick(i) {
-                counts[bin(p)] += 1.0;
-                total += 1;
-            }
+        for p in samples {
+            counts[bin(&p)] += 1.0;
+            total += 1;
         }
         if total == 0 {
             return None;
@@ -101,6 +121,11 @@ impl ColourModel {
         Some(Self {
             density: counts.iter().map(|c| (c + floor) / sum).collect(),
         })
+    }
+
+    /// The density at colour `p`.
+    pub(super) fn at(&self, p: &image::Rgb<u8>) -> f32 {
+        self.density[bin(p)]
     }
 }
 
