@@ -104,16 +104,18 @@ impl Mesher {
             let num_cards = self.mesh_level(level, finest, num_fruit / 3, lod);
             if level == 0 {
                 lod.merged_leaves.clear();
+                lod.billboards = None;
+                lod.num_leaf_indices = 6 * num_cards;
             } else {
-                lod_leaves::merge_cards_into(
+                lod_leaves::coarse_leaves_into(
                     &meshes.leaves,
                     num_cards,
                     ground_y,
+                    level + 1 == LOD_TRIANGLE_FRACTIONS.len(),
                     &mut self.merge_scratch,
-                    &mut lod.merged_leaves,
+                    lod,
                 );
             }
-            lod.num_leaf_indices = 6 * num_cards;
             lod.num_fruit_indices = num_fruit;
         }
         meshes.leaf_card.set(&params.leaves);
