@@ -784,3 +784,132 @@ fn srgb8_of(c: f32) -> f32 {
     };
     (s * 255.0).round()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    use crate::geometry::crown::AlphaMask;
+    use crate::geometry::synthetic::{branching_skeleton, crown_ambient};
+    use crate::geometry::{LeafParams, MeshParams, build_meshes};
+
+    fn cards() -> TreeMesh {
+        let params = MeshParams {
+            leaves: LeafParams {
+                leaves_per_metre: 60.0,
+                ..LeafParams::default()
+            },
+            ..MeshParams::default()
+        };
+        let skeleton = branching_skeleton(3_000, 5);
+        build_meshes(&skeleton, &params, &crown_ambient(Vec3::Y, 1.5)).leaves
+    }
+
+    #[test]
+    fn every_card_stands_in_one_quad_within_the_budget_and_above_the_ground() {
+        let cards = cards();
+        let total = cards.indices.len() / 6;
+        assert!(total > 1_000, "{total} cards");
+        let (mut cloud, mut quads) = (BillboardCloud::default(), TreeMesh::default());
+        let ground_y = 0.4;
+        let budget = total / 5;
+        build_cloud_into(
+            &cards,
+            budget,
+            ground_y,
+            &mut CloudScratch::default(),
+            &mut cloud,
+            &mut quads,
+        );
+        let n = cloud.num_quads();
+        assert!(
+            n <= budget && n > budget / 2,
+            "{n} quads for a budget of {budget}"
+        );
+        assert_eq!(quads.indices.len(), 6 * n);
+        assert_eq!(cloud.starts.len(), n + 1);
+        let mut members = cloud.members.clone();
+        members.sort_unstable();
+        assert_eq!(members, (0..total as u32).collect::<Vec<_>>());
+        assert!(quads.positions.iter().all(|p| p[1] >= ground_y - 1e-4));
+        // Rectangles lie in the atlas and do not overlap.
+        let [w, h] = cloud.atlas_size;
+        let mut used = vec![false; (w * h) as usize];
+        for &[x, y, rw, rh] in &cloud.rects {
+            assert!(x + rw <= w && y + rh <= h);
+            for ty in y..y + rh {
+                for tx in x..x + rw {
+                    let i = (ty * w + tx) as usize;
+                    assert!(!used[i], "rectangles overlap at {tx}, {ty}");
+                    used[i] = true;
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_quad_per_card_bakes_the_card_texture_coverage() {
+        // One flat card facing +Z: its quad is the card and the atlas holds its texture's
+        // opaque share.
+        let mut cards = TreeMesh::default();
+        let (p, n, uv, a) = cards.grow_vertices(4);
+        p.copy_from_slice(&[
+            [0.0, 1.0, 0.0],
+            [0.2, 1.0, 0.0],
+            [0.0, 1.4, 0.0],
+            [0.2, 1.4, 0.0],
+        ]);
+        n.fill([0.0, 0.0, 1.0]);
+        uv.copy_from_slice(&[[0.0, 1.0], [1.0, 1.0], [0.0, 0.0], [1.0, 0.0]]);
+        a.fill(1.0);
+        push_quad_indices(&mut cards, 0, 1);
+        // A texture whose left half is opaque.
+        let texture = RgbaImage::from_fn(64, 64, |x, _| {
+            if x < 32 {
+                Rgba([40, 120, 30, 255])
+            } else {
+                Rgba([0, 0, 0, 0])
+            }
+        });
+        let (mut cloud, mut quads) = (BillboardCloud::default(), TreeMesh::default());
+        build_cloud_into(
+            &cards,
+            4,
+            0.0,
+            &mut CloudScratch::default(),
+            &mut cloud,
+            &mut quads,
+        );
+        assert_eq!(cloud.num_quads(), 1);
+        let atlas = bake_atlas(&cloud, &quads, &cards, &texture);
+        let [x, y, w, h] = cloud.rects[0];
+        let rect = image::imageops::crop_imm(&atlas, x, y, w, h).to_image();
+        let opaque = AlphaMask::from_texture(&rect).opaque_fraction();
+        assert!((opaque - 0.5).abs() < 0.05, "{opaque} of the quad opaque");
+        // The left half is the opaque one, seen from the card's front.
+        let left = rect.get_pixel(w / 4, h / 2);
+        let right = rect.get_pixel(3 * w / 4, h / 2);
+        assert_eq!((left[3], right[3]), (255, 0));
+        assert!(left[1] > left[0] && left[1] > left[2], "green: {left:?}");
+    }
+
+    #[test]
+    fn clusters_bound_their_depth_and_split_down_to_single_cards() {
+        let codes = [0u32, 1, 2, 9, 64, 65];
+        let depths = [
+            (0.0, 0.1),
+            (0.0, 0.1),
+            (0.5, 0.6),
+            (0.0, 0.1),
+            (2.0, 2.1),
+            (2.0, 2.1),
+        ];
+        // Unbounded depth: the whole facing is one cluster.
+        assert_eq!(count_clusters(&codes, &depths, 10.0), 1);
+        // No depth: single cards.
+        assert_eq!(count_clusters(&codes, &depths, 0.0), 6);
+        let limit = smallest_limit(&codes, &depths, 3);
+        assert!(count_clusters(&codes, &depths, limit) <= 3);
+        assert!(count_clusters(&codes, &depths, 0.9 * limit) > 3);
+    }
+}
