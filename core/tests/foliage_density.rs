@@ -270,8 +270,10 @@ fn the_coarsest_level_merges_cards_keeping_the_leaf_area_at_15_percent_of_the_tr
 }
 
 #[test]
-#[ignore = "issue #25 open: the coarsest level's filtered side view differs from the finest's \
-            by 8.8% (willow at 40 years) to 23.6% (poplar at 15), not at most 10%"]
+#[ignore = "issue #25 open: the coarsest level (a billboard cloud) differs from the finest's \
+            side view by 8.0% (oak at 40 years) to 16.2% (poplar at 15): within 10% only for the \
+            oak and the maple at 15 and 40; the rest is the thin wood the level drops and \
+            parallax in deep clusters (see the README)"]
 fn the_coarsest_level_keeps_the_side_silhouette_within_10_percent() {
     let failures: Vec<String> = coarsest_levels()
         .iter()
