@@ -549,13 +549,14 @@ fn build(meshes: &TreeMeshes, path: &Path, options: GlbOptions) -> Result<Vec<u8
         }
         let mut children = Vec::new();
         let plain_leaves = leaf_uv_box.as_ref().zip(leaf);
-        let atlas = match lod.billboards.as_ref().filter(|_| lod.num_leaf_indices > 0) {
-            Some(cloud) => Some((
-                cloud,
-                card_texture.get_or_insert_with(|| card_texture_of(meshes)),
-            )),
-            None => None,
-        };
+        let atlas = lod
+            .billboards
+            .as_ref()
+            .filter(|_| lod.num_leaf_indices > 0)
+            .map(|cloud| {
+                let texture = card_texture.get_or_insert_with(|| card_texture_of(meshes));
+                (cloud, texture)
+            });
         if let Some((cloud, texture)) = atlas {
             // A billboard cloud: plain quads (positions and atlas coordinates only) drawn from
             // the level's own atlas, which carries the leaves' colour and light.

@@ -337,7 +337,7 @@ fn smallest_limit(codes: &[u32], depths: &[(f32, f32)], max_quads: usize) -> f32
     if count_clusters(codes, depths, lo) <= max_quads {
         return lo;
     }
-    for _ in 0..24 {
+    for _ in 0..12 {
         let mid = 0.5 * (lo + hi);
         if count_clusters(codes, depths, mid) <= max_quads {
             hi = mid;
