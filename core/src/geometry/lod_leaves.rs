@@ -66,6 +66,21 @@ pub(crate) fn coarse_leaves_into(
     lod.num_leaf_indices = lod.merged_leaves.indices.len();
 }
 
+/// `num_cards` merged cards standing for all the cards of `cards` (the finest level's), none
+/// below y = `ground_y`, into `out`: what [`merge_cards_into`] makes for the levels above the
+/// coarsest, for a renderer that draws the coarsest level with the species' leaf texture
+/// rather than a billboard cloud's atlas (the cloud's quads drawn with the leaf texture would
+/// show a leaf card where a cluster of leaves should be).
+pub fn merged_cards_into(cards: &TreeMesh, num_cards: usize, ground_y: f32, out: &mut TreeMesh) {
+    merge_cards_into(
+        cards,
+        num_cards,
+        ground_y,
+        &mut MergeScratch::default(),
+        out,
+    );
+}
+
 /// `num_cards` cards standing for all the cards of `cards` (quads of 4 vertices and 6 indices,
 /// card k's vertices at 4k), into `out` (cleared first), none below y = `ground_y`.
 pub(crate) fn merge_cards_into(

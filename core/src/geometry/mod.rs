@@ -60,6 +60,7 @@ use crate::tree::{NodeId, Skeleton};
 
 pub use leaf_card::LeafCard;
 pub use leaves::{FruitParams, LeafParams};
+pub use lod_leaves::merged_cards_into;
 pub use looks::{
     BarkKind, BarkLook, FruitLook, LeafShape, Looks, Season, SeasonColors, TreeShade,
     build_tree_level, build_tree_meshes, build_tree_meshes_in, build_tree_meshes_with,
