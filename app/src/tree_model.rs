@@ -87,6 +87,9 @@ impl TreeMesher {
     pub fn mesh_in(&mut self, tree: &Tree, season: Season) -> &TreeMesh {
         let params = mesh_params_in(&tree.species, season);
         let shade = TreeShade::in_season(tree, season);
+        // The renderer draws the coarsest level's leaves with the card texture: merged cards,
+        // not a billboard cloud (clustering one costs tens of milliseconds a re-mesh).
+        self.mesher.set_coarsest_as_cards(true);
         self.mesher.build_into(
             &tree.skeleton,
             &params,
@@ -225,15 +228,30 @@ mod tests {
     }
 
     #[test]
-    fn the_coarsest_level_draws_merged_cards_as_many_as_its_cloud_has_quads() {
+    fn the_coarsest_level_is_drawn_as_merged_cards_never_as_a_cloud() {
         let tree = golden_tree();
         let mut mesher = TreeMesher::default();
         let mesh = mesher.mesh(&tree).clone();
         let coarsest = mesher.meshes.lods.last().expect("levels");
-        let cloud = coarsest
+        assert!(coarsest.billboards.is_none(), "the app builds no cloud");
+        assert_eq!(
+            mesh.levels.last().unwrap().cards.len(),
+            coarsest.num_leaf_indices / 6
+        );
+        // Meshes with a cloud (the core's default) are drawn as merged cards all the same.
+        let mut meshes = TreeMeshes::default();
+        let params = mesh_params_in(&tree.species, Season::Summer);
+        let shade = TreeShade::in_season(&tree, Season::Summer);
+        let ambient = |p: Vec3| shade.at(p);
+        Mesher::default().build_into(&tree.skeleton, &params, &ambient, Levels::All, &mut meshes);
+        let cloud = meshes
+            .lods
+            .last()
+            .unwrap()
             .billboards
             .as_ref()
-            .expect("the coarsest is a billboard cloud");
+            .expect("a cloud");
+        let mesh = draw_mesh(&meshes, tree.skeleton.ground_y());
         let drawn = &mesh.levels.last().expect("levels").cards;
         assert!(!drawn.is_empty());
         assert_eq!(drawn.len(), cloud.num_quads());

@@ -50,11 +50,21 @@ pub struct Mesher {
     fruit_centers: Vec<Vec3>,
     /// Parents and children of the internodes, for the topology.
     links: Links,
+    /// Whether the coarsest level's leaves are merged cards (as the other coarse levels')
+    /// rather than a billboard cloud: for a renderer that draws every level with the leaf
+    /// texture, so that it does not pay for clustering a cloud it never draws.
+    coarsest_as_cards: bool,
 }
 
 impl Mesher {
     pub fn new() -> Self {
         Mesher::default()
+    }
+
+    /// Makes the coarsest level's leaves merged cards instead of a billboard cloud (the
+    /// default) from the next build on.
+    pub fn set_coarsest_as_cards(&mut self, as_cards: bool) {
+        self.coarsest_as_cards = as_cards;
     }
 
     /// Builds the branch meshes of `levels` and the leaf and fruit buffers of `skeleton` into
@@ -111,7 +121,7 @@ impl Mesher {
                     &meshes.leaves,
                     num_cards,
                     ground_y,
-                    level + 1 == LOD_TRIANGLE_FRACTIONS.len(),
+                    level + 1 == LOD_TRIANGLE_FRACTIONS.len() && !self.coarsest_as_cards,
                     &mut self.merge_scratch,
                     lod,
                 );
