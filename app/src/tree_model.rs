@@ -4,7 +4,8 @@
 
 use glam::Vec3;
 use sylva_core::geometry::{
-    Levels, Mesher, Season, TreeMesh as CoreMesh, TreeMeshes, TreeShade, mesh_params_in,
+    Levels, Mesher, Season, TreeMesh as CoreMesh, TreeMeshes, TreeShade, merged_cards_into,
+    mesh_params_in,
 };
 use sylva_core::{Skeleton, Tree};
 
@@ -71,6 +72,8 @@ pub struct TreeMesher {
     mesher: Mesher,
     meshes: TreeMeshes,
     mesh: TreeMesh,
+    /// The coarsest level's merged cards, drawn instead of its billboard cloud.
+    coarse_cards: CoreMesh,
 }
 
 impl TreeMesher {
@@ -84,6 +87,9 @@ impl TreeMesher {
     pub fn mesh_in(&mut self, tree: &Tree, season: Season) -> &TreeMesh {
         let params = mesh_params_in(&tree.species, season);
         let shade = TreeShade::in_season(tree, season);
+        // The renderer draws the coarsest level's leaves with the card texture: merged cards,
+        // not a billboard cloud (clustering one costs tens of milliseconds a re-mesh).
+        self.mesher.set_coarsest_as_cards(true);
         self.mesher.build_into(
             &tree.skeleton,
             &params,
@@ -91,7 +97,12 @@ impl TreeMesher {
             Levels::All,
             &mut self.meshes,
         );
-        draw_mesh_into(&self.meshes, &mut self.mesh);
+        draw_mesh_into(
+            &self.meshes,
+            tree.skeleton.ground_y(),
+            &mut self.coarse_cards,
+            &mut self.mesh,
+        );
         &self.mesh
     }
 
@@ -101,25 +112,39 @@ impl TreeMesher {
     }
 }
 
-/// The renderer's mesh of `sylva_core` meshes: each level's bark, and its leaf cards as
-/// instances of the species' card.
-pub fn draw_mesh(meshes: &TreeMeshes) -> TreeMesh {
+/// The renderer's mesh of `sylva_core` meshes of a tree standing at y = `ground_y`: each
+/// level's bark, and its leaf cards as instances of the species' card.
+pub fn draw_mesh(meshes: &TreeMeshes, ground_y: f32) -> TreeMesh {
     let mut mesh = TreeMesh::default();
-    draw_mesh_into(meshes, &mut mesh);
+    draw_mesh_into(meshes, ground_y, &mut CoreMesh::default(), &mut mesh);
     mesh
 }
 
-/// [`draw_mesh`] into `out`, reusing its buffers.
-fn draw_mesh_into(meshes: &TreeMeshes, out: &mut TreeMesh) {
+/// [`draw_mesh`] into `out`, reusing its buffers and `coarse_cards`. A level that is a
+/// billboard cloud (the coarsest) is drawn as merged cards, as many as its quads: the renderer
+/// draws every level's leaves with the species' card texture, and the cloud's quads need their
+/// own atlas (`sylva_core::geometry::billboard_cloud::bake_atlas`), which it does not bind.
+fn draw_mesh_into(
+    meshes: &TreeMeshes,
+    ground_y: f32,
+    coarse_cards: &mut CoreMesh,
+    out: &mut TreeMesh,
+) {
     out.levels
         .resize_with(meshes.lods.len(), TreeLevel::default);
     for (lod, level) in meshes.lods.iter().zip(&mut out.levels) {
         lit_into(&lod.branches, &mut level.branches);
-        cards_into(
-            lod.leaves_in(&meshes.leaves),
-            lod.num_leaf_indices,
-            &mut level.cards,
-        );
+        if lod.billboards.is_some() {
+            let num_quads = lod.num_leaf_indices.min(lod.merged_leaves.indices.len()) / 6;
+            merged_cards_into(&meshes.leaves, num_quads, ground_y, coarse_cards);
+            cards_into(coarse_cards, coarse_cards.indices.len(), &mut level.cards);
+        } else {
+            cards_into(
+                lod.leaves_in(&meshes.leaves),
+                lod.num_leaf_indices,
+                &mut level.cards,
+            );
+        }
         fruit_into(&meshes.fruit, lod.num_fruit_indices, &mut level.fruit);
     }
     let colors = &meshes.colors;
@@ -200,5 +225,52 @@ mod tests {
             .collect();
         tree.remove_subtrees(&cut);
         assert_eq!(mesher.mesh(&tree), &mesh_of(&tree));
+    }
+
+    #[test]
+    fn the_coarsest_level_is_drawn_as_merged_cards_never_as_a_cloud() {
+        let tree = golden_tree();
+        let mut mesher = TreeMesher::default();
+        let mesh = mesher.mesh(&tree).clone();
+        let coarsest = mesher.meshes.lods.last().expect("levels");
+        assert!(coarsest.billboards.is_none(), "the app builds no cloud");
+        assert_eq!(
+            mesh.levels.last().unwrap().cards.len(),
+            coarsest.num_leaf_indices / 6
+        );
+        // Meshes with a cloud (the core's default) are drawn as merged cards all the same.
+        let mut meshes = TreeMeshes::default();
+        let params = mesh_params_in(&tree.species, Season::Summer);
+        let shade = TreeShade::in_season(&tree, Season::Summer);
+        let ambient = |p: Vec3| shade.at(p);
+        Mesher::default().build_into(&tree.skeleton, &params, &ambient, Levels::All, &mut meshes);
+        let cloud = meshes
+            .lods
+            .last()
+            .unwrap()
+            .billboards
+            .as_ref()
+            .expect("a cloud");
+        let mesh = draw_mesh(&meshes, tree.skeleton.ground_y());
+        let drawn = &mesh.levels.last().expect("levels").cards;
+        assert!(!drawn.is_empty());
+        assert_eq!(drawn.len(), cloud.num_quads());
+        // Merged cards keep the leaf area of the cards they stand for (a cloud's quads,
+        // bounding rectangles of clusters, hold more).
+        let area = |cards: &[CardInstance]| -> f32 {
+            cards
+                .iter()
+                .map(|c| Vec3::from(c.across).cross(Vec3::from(c.along)).length())
+                .sum()
+        };
+        let (finest, coarse) = (area(mesh.cards()), area(drawn));
+        assert!(
+            (coarse - finest).abs() < 0.02 * finest,
+            "{coarse} vs {finest}"
+        );
+        let ground_y = tree.skeleton.ground_y();
+        for card in drawn {
+            assert!(card.corners().iter().all(|p| p.y >= ground_y - 1e-4));
+        }
     }
 }

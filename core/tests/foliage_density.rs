@@ -176,14 +176,17 @@ fn no_leaf_or_fruit_of_a_40_year_weeping_willow_or_oak_is_below_the_ground() {
 /// Ages at which the coarsest level of detail is compared with the finest (issue #25).
 const LOD_AGES_YEARS: [f32; 2] = [15.0, 40.0];
 
-/// A preset at an age; its coarsest level's triangle share, card area share, side view
-/// difference, and the side view difference with the cards unmerged.
+/// A preset at an age; its coarsest level's triangle share, the merged-card level's card area
+/// share, the coarsest level's side view difference, and that difference with the coarsest
+/// level's leaves replaced by as many of the finest level's cards.
 type CoarsestLevel = (String, f32, f32, f32, f32);
 
 /// The coarsest level of every preset at each of [`LOD_AGES_YEARS`]: its triangles over the
-/// finest level's, its card area over the finest level's, how far its filtered side view
-/// departs from the finest level's, and the same for the coarse level's cards unmerged (as
-/// many of the finest level's cards, unscaled), grown once for both tests.
+/// finest level's; the card area of the coarsest level of merged cards (the coarsest level is a
+/// billboard cloud, whose quads hold their leaves in an atlas rather than in a card's area)
+/// over the finest level's; how far the coarsest level's filtered side view departs from the
+/// finest level's, and the same with its leaves as many of the finest level's cards, unscaled
+/// (dropping cards), grown once for both tests.
 fn coarsest_levels() -> &'static [CoarsestLevel] {
     static LEVELS: OnceLock<Vec<CoarsestLevel>> = OnceLock::new();
     LEVELS.get_or_init(|| {
@@ -209,18 +212,25 @@ fn coarsest_level(tree: &Tree) -> CoarsestLevel {
         let level = &m.lods[lod];
         leaf_card_area_m2(level.leaves_in(&m.leaves), level.num_leaf_indices)
     };
-    let blade = area(&meshes, coarsest) / area(&meshes, 0);
+    let merged = (1..meshes.lods.len())
+        .rev()
+        .find(|&level| meshes.lods[level].billboards.is_none())
+        .unwrap_or(coarsest);
+    let blade = area(&meshes, merged) / area(&meshes, 0);
     // The side views filtered as a renderer shows a tree 100 pixels tall.
     let difference = |m: &sylva_core::geometry::TreeMeshes| {
         side_silhouette_difference(m, coarsest).expect("a side view")
     };
     let mut dropped = meshes.clone();
     dropped.lods[coarsest].merged_leaves = meshes.leaves.clone();
+    dropped.lods[coarsest].billboards = None;
+    dropped.lods[coarsest].num_leaf_indices =
+        6 * (meshes.lods[coarsest].num_leaf_indices / 6).min(meshes.leaves.indices.len() / 6);
     let merged_difference = difference(&meshes);
     let dropped_difference = difference(&dropped);
     println!(
-        "{name}: LOD{coarsest} {:.1}% of the triangles, {:.1}% of the card area; side view \
-         differs by {:.1}% (cards unmerged: {:.1}%)",
+        "{name}: LOD{coarsest} {:.1}% of the triangles (LOD{merged} {:.1}% of the card area); \
+         side view differs by {:.1}% (dropping cards: {:.1}%)",
         100.0 * triangles,
         100.0 * blade,
         100.0 * merged_difference,
@@ -260,8 +270,10 @@ fn the_coarsest_level_merges_cards_keeping_the_leaf_area_at_15_percent_of_the_tr
 }
 
 #[test]
-#[ignore = "issue #25 open: the coarsest level's filtered side view differs from the finest's \
-            by 8.8% (willow at 40 years) to 23.6% (poplar at 15), not at most 10%"]
+#[ignore = "issue #25 open: the coarsest level (a billboard cloud) differs from the finest's \
+            side view by 8.0% (oak at 40 years) to 16.2% (poplar at 15): within 10% only for the \
+            oak and the maple at 15 and 40; the rest is the thin wood the level drops and \
+            parallax in deep clusters (see the README)"]
 fn the_coarsest_level_keeps_the_side_silhouette_within_10_percent() {
     let failures: Vec<String> = coarsest_levels()
         .iter()

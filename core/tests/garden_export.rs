@@ -52,12 +52,19 @@ fn json_chunk(glb: &[u8]) -> serde_json::Value {
     serde_json::from_slice(&glb[20..20 + length]).expect("JSON chunk")
 }
 
-/// Bytes of a document's images (the PNG textures in its BIN chunk).
+/// Whether an image is a tree's own coarsest-level leaf atlas (not shared by its species).
+fn is_atlas(image: &serde_json::Value) -> bool {
+    image["name"].as_str().is_some_and(|n| n.contains("atlas"))
+}
+
+/// Bytes of a document's species images (the bark and leaf PNG textures in its BIN chunk; a
+/// tree's own leaf atlas counts as its geometry).
 fn image_bytes(json: &serde_json::Value) -> u64 {
     let views = json["bufferViews"].as_array().expect("views");
     json["images"].as_array().map_or(0, |images| {
         images
             .iter()
+            .filter(|i| !is_atlas(i))
             .map(|i| {
                 views[i["bufferView"].as_u64().expect("view") as usize]["byteLength"]
                     .as_u64()
@@ -102,9 +109,21 @@ fn a_garden_glb_passes_the_validator_with_one_node_per_tree_and_shared_textures(
         let children = node["children"].as_array().map_or(0, Vec::len);
         assert!(children >= 1, "tree {k} holds its meshes");
     }
-    // Two species: one bark and one leaf texture each, whatever the number of trees.
-    assert_eq!(json["images"].as_array().map(Vec::len), Some(4));
-    assert_eq!(json["textures"].as_array().map(Vec::len), Some(4));
+    // Two species: one bark and one leaf texture each, whatever the number of trees, and each
+    // tree its own coarsest level's leaf atlas.
+    let images = json["images"].as_array().expect("images");
+    let atlases = images.iter().filter(|i| is_atlas(i)).count();
+    let with_atlas = meshes
+        .iter()
+        .filter(|m| {
+            m.lods
+                .iter()
+                .any(|l| l.billboards.is_some() && l.num_leaf_indices > 0)
+        })
+        .count();
+    assert_eq!(atlases, with_atlas);
+    assert_eq!(images.len(), 4 + atlases);
+    assert_eq!(json["textures"].as_array().map(Vec::len), Some(4 + atlases));
     let materials = json["materials"].as_array().expect("materials");
     let names: Vec<&str> = materials
         .iter()

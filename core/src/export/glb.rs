@@ -9,6 +9,7 @@ use json::validation::{Checked::Valid, USize64};
 use super::leaf_instances::{CardKind, EXT_MESH_GPU_INSTANCING, card_instances, common_scale};
 use super::quantize::{self, Quantizer, UvBox};
 use super::{ExportError, GlbOptions, TEXTURE_SIZE, ambient_color};
+use crate::geometry::billboard_cloud::bake_atlas;
 use crate::geometry::leaf_card::card_texture;
 use crate::geometry::textures::{bark_texture, png_bytes};
 use crate::geometry::{TreeMesh, TreeMeshes};
@@ -55,9 +56,11 @@ struct VertexViews {
     /// The quantized positions (for the accessors' bounds) and their view.
     positions: Vec<[i16; 4]>,
     position_view: json::Index<json::buffer::View>,
-    normals: json::Index<json::buffer::View>,
+    /// Normals and ambient colours; none for a billboard cloud's quads, which are flat (a reader
+    /// computes the same normal) and whose atlas carries the light.
+    normals: Option<json::Index<json::buffer::View>>,
     uvs: Option<json::Index<json::buffer::View>>,
-    colors: json::Index<json::buffer::View>,
+    colors: Option<json::Index<json::buffer::View>>,
 }
 
 /// A run of triangles whose vertices span fewer than 2¹⁶ − 1 indices: one primitive with
@@ -184,13 +187,15 @@ impl<'a> Builder<'a> {
 
     /// The buffer views of the first `num_vertices` vertices of `mesh`, quantized by
     /// `quantizer`; texture coordinates only with a `uvs` box to quantize them in (a part drawn
-    /// without a texture gets none, which readers would carry unused).
+    /// without a texture gets none, which readers would carry unused); normals and colours only
+    /// when `lit`.
     fn vertex_views(
         &mut self,
         mesh: &TreeMesh,
         num_vertices: usize,
         uvs: Option<&UvBox>,
         quantizer: &Quantizer,
+        lit: bool,
     ) -> VertexViews {
         use json::buffer::Target::ArrayBuffer;
         let positions: Vec<[i16; 4]> = mesh.positions[..num_vertices]
@@ -203,11 +208,13 @@ impl<'a> Builder<'a> {
             .flat_map(|v| v.to_le_bytes())
             .collect();
         let position_view = self.view(&bytes, Some(ArrayBuffer), Some(8));
-        let bytes: Vec<u8> = mesh.normals[..num_vertices]
-            .iter()
-            .flat_map(|&n| quantize::normal(n).map(|c| c as u8))
-            .collect();
-        let normals = self.view(&bytes, Some(ArrayBuffer), Some(4));
+        let normals = lit.then(|| {
+            let bytes: Vec<u8> = mesh.normals[..num_vertices]
+                .iter()
+                .flat_map(|&n| quantize::normal(n).map(|c| c as u8))
+                .collect();
+            self.view(&bytes, Some(ArrayBuffer), Some(4))
+        });
         let uvs = uvs.map(|uv_box| {
             let bytes: Vec<u8> = mesh.uvs[..num_vertices]
                 .iter()
@@ -216,14 +223,16 @@ impl<'a> Builder<'a> {
                 .collect();
             self.view(&bytes, Some(ArrayBuffer), Some(4))
         });
-        let bytes: Vec<u8> = mesh.ambient[..num_vertices]
-            .iter()
-            .flat_map(|&a| {
-                let c = quantize::unorm8(ambient_color(a));
-                [c, c, c, 255]
-            })
-            .collect();
-        let colors = self.view(&bytes, Some(ArrayBuffer), Some(4));
+        let colors = lit.then(|| {
+            let bytes: Vec<u8> = mesh.ambient[..num_vertices]
+                .iter()
+                .flat_map(|&a| {
+                    let c = quantize::unorm8(ambient_color(a));
+                    [c, c, c, 255]
+                })
+                .collect();
+            self.view(&bytes, Some(ArrayBuffer), Some(4))
+        });
         VertexViews {
             positions,
             position_view,
@@ -299,14 +308,18 @@ impl<'a> Builder<'a> {
                 Some(bounds),
             );
             attributes.insert(Valid(json::mesh::Semantic::Positions), position);
-            let normal = self.accessor(views.normals, 4 * first, count, I8, Vec3, true, None);
-            attributes.insert(Valid(json::mesh::Semantic::Normals), normal);
+            if let Some(normals) = views.normals {
+                let normal = self.accessor(normals, 4 * first, count, I8, Vec3, true, None);
+                attributes.insert(Valid(json::mesh::Semantic::Normals), normal);
+            }
             if let Some(uvs) = views.uvs {
                 let uv = self.accessor(uvs, 4 * first, count, U16, Vec2, true, None);
                 attributes.insert(Valid(json::mesh::Semantic::TexCoords(0)), uv);
             }
-            let color = self.accessor(views.colors, 4 * first, count, U8, Vec4, true, None);
-            attributes.insert(Valid(json::mesh::Semantic::Colors(0)), color);
+            if let Some(colors) = views.colors {
+                let color = self.accessor(colors, 4 * first, count, U8, Vec4, true, None);
+                attributes.insert(Valid(json::mesh::Semantic::Colors(0)), color);
+            }
             let indices = self.accessor(
                 index_view,
                 index_offset,
@@ -427,6 +440,11 @@ impl<'a> Builder<'a> {
     }
 }
 
+/// The leaf cards' texture at the export's size.
+fn card_texture_of(meshes: &TreeMeshes) -> image::RgbaImage {
+    card_texture(meshes, TEXTURE_SIZE)
+}
+
 pub(super) fn f32_bytes<'a>(values: impl Iterator<Item = &'a f32>) -> Vec<u8> {
     values.flat_map(|v| v.to_le_bytes()).collect()
 }
@@ -466,13 +484,17 @@ fn build(meshes: &TreeMeshes, path: &Path, options: GlbOptions) -> Result<Vec<u8
         false,
     );
     let leaf_uv_box = (!options.instanced_leaves).then(|| {
-        let merged = meshes.lods.iter().flat_map(|lod| &lod.merged_leaves.uvs);
+        let merged = meshes
+            .lods
+            .iter()
+            .filter(|lod| lod.billboards.is_none())
+            .flat_map(|lod| &lod.merged_leaves.uvs);
         UvBox::of(meshes.leaves.uvs.iter().chain(merged))
     });
     let leaf = if meshes.leaves.is_empty() {
         None
     } else {
-        let leaf_png = builder.png("leaf texture", &card_texture(meshes, TEXTURE_SIZE))?;
+        let leaf_png = builder.png("leaf texture", &card_texture_of(meshes))?;
         let texture = builder.texture("leaf", &leaf_png, json::texture::WrappingMode::ClampToEdge);
         // Plain cards carry quantized texture coordinates; the card meshes carry their own.
         let uv_box = leaf_uv_box.as_ref().filter(|_| !options.instanced_leaves);
@@ -482,7 +504,7 @@ fn build(meshes: &TreeMeshes, path: &Path, options: GlbOptions) -> Result<Vec<u8
         None
     } else {
         let num_vertices = meshes.fruit.num_vertices();
-        let views = builder.vertex_views(&meshes.fruit, num_vertices, None, &quantizer);
+        let views = builder.vertex_views(&meshes.fruit, num_vertices, None, &quantizer, true);
         Some((
             builder.material(
                 "fruit",
@@ -496,6 +518,7 @@ fn build(meshes: &TreeMeshes, path: &Path, options: GlbOptions) -> Result<Vec<u8
         ))
     };
     let card_size = (meshes.leaf_card.width_m, meshes.leaf_card.length_m);
+    let mut card_texture: Option<image::RgbaImage> = None;
     let mut card_meshes: Vec<(CardKind, Option<[u32; 3]>, json::Index<json::Mesh>)> = Vec::new();
     let mut level_nodes = Vec::new();
     let num_levels = if options.coarse_levels {
@@ -507,8 +530,13 @@ fn build(meshes: &TreeMeshes, path: &Path, options: GlbOptions) -> Result<Vec<u8
         let mut primitives = Vec::new();
         if !lod.branches.is_empty() {
             let branches = &lod.branches;
-            let views =
-                builder.vertex_views(branches, branches.num_vertices(), Some(&uv_box), &quantizer);
+            let views = builder.vertex_views(
+                branches,
+                branches.num_vertices(),
+                Some(&uv_box),
+                &quantizer,
+                true,
+            );
             primitives.extend(builder.primitives(branches, &views, branches.indices.len(), bark));
         }
         if let Some((material, views)) = fruit.as_ref().filter(|_| lod.num_fruit_indices > 0) {
@@ -521,10 +549,31 @@ fn build(meshes: &TreeMeshes, path: &Path, options: GlbOptions) -> Result<Vec<u8
         }
         let mut children = Vec::new();
         let plain_leaves = leaf_uv_box.as_ref().zip(leaf);
-        if let Some((uv_box, material)) = plain_leaves.filter(|_| lod.num_leaf_indices > 0) {
+        let atlas = lod
+            .billboards
+            .as_ref()
+            .filter(|_| lod.num_leaf_indices > 0)
+            .map(|cloud| {
+                let texture = card_texture.get_or_insert_with(|| card_texture_of(meshes));
+                (cloud, texture)
+            });
+        if let Some((cloud, texture)) = atlas {
+            // A billboard cloud: plain quads (positions and atlas coordinates only) drawn from
+            // the level's own atlas, which carries the leaves' colour and light.
+            let quads = &lod.merged_leaves;
+            let image = bake_atlas(cloud, quads, &meshes.leaves, texture);
+            let png = builder.png("leaf atlas", &image)?;
+            let name = format!("leaf atlas LOD{level}");
+            let texture = builder.texture(&name, &png, json::texture::WrappingMode::ClampToEdge);
+            let material = builder.material(&name, Some(texture), None, [1.0; 4], 0.6, true);
+            let num_vertices = quads.num_vertices_of_prefix(lod.num_leaf_indices);
+            let views =
+                builder.vertex_views(quads, num_vertices, Some(&UvBox::UNIT), &quantizer, false);
+            primitives.extend(builder.primitives(quads, &views, lod.num_leaf_indices, material));
+        } else if let Some((uv_box, material)) = plain_leaves.filter(|_| lod.num_leaf_indices > 0) {
             let cards = lod.leaves_in(&meshes.leaves);
             let num_vertices = cards.num_vertices_of_prefix(lod.num_leaf_indices);
-            let views = builder.vertex_views(cards, num_vertices, Some(uv_box), &quantizer);
+            let views = builder.vertex_views(cards, num_vertices, Some(uv_box), &quantizer, true);
             primitives.extend(builder.primitives(cards, &views, lod.num_leaf_indices, material));
         } else if let Some(material) = leaf.filter(|_| lod.num_leaf_indices > 0) {
             let cards = lod.leaves_in(&meshes.leaves);

@@ -57,6 +57,12 @@ pub(super) struct UvBox {
 }
 
 impl UvBox {
+    /// The unit square: coordinates stored as they are (no texture transform).
+    pub(super) const UNIT: UvBox = UvBox {
+        offset: [0.0; 2],
+        scale: [1.0; 2],
+    };
+
     /// The box of `uvs` (the unit square when there are none).
     pub(super) fn of<'a>(uvs: impl Iterator<Item = &'a [f32; 2]>) -> Self {
         let (lo, hi) = uvs.fold(

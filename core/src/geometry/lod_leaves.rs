@@ -18,8 +18,9 @@
 
 use glam::Vec3;
 
-use super::TreeMesh;
+use super::billboard_cloud::{self, CloudScratch};
 use super::leaves::push_quad_indices;
+use super::{Lod, TreeMesh};
 
 /// Bits per axis of the Morton code of a card centre.
 const MORTON_BITS: u32 = 10;
@@ -31,6 +32,53 @@ pub(crate) struct MergeScratch {
     centers: Vec<(Vec3, f32)>,
     /// Morton code (high 32 bits) and card index (low 32 bits), sorted.
     order: Vec<u64>,
+    /// Working memory of the coarsest level's billboard cloud.
+    cloud: CloudScratch,
+}
+
+/// The leaves of coarse level `lod` (its branches already meshed), at most `num_quads` quads
+/// standing for all the cards of `cards`, the finest level's: the coarsest level a billboard
+/// cloud ([`billboard_cloud`]), which keeps the gaps between a cluster's leaves, the others
+/// merged cards ([`merge_cards_into`]), which the species' leaf texture draws. Sets the level's
+/// leaf index count.
+pub(crate) fn coarse_leaves_into(
+    cards: &TreeMesh,
+    num_quads: usize,
+    ground_y: f32,
+    coarsest: bool,
+    scratch: &mut MergeScratch,
+    lod: &mut Lod,
+) {
+    if coarsest {
+        let cloud = lod.billboards.get_or_insert_with(Default::default);
+        billboard_cloud::build_cloud_into(
+            cards,
+            num_quads,
+            ground_y,
+            &mut scratch.cloud,
+            cloud,
+            &mut lod.merged_leaves,
+        );
+    } else {
+        lod.billboards = None;
+        merge_cards_into(cards, num_quads, ground_y, scratch, &mut lod.merged_leaves);
+    }
+    lod.num_leaf_indices = lod.merged_leaves.indices.len();
+}
+
+/// `num_cards` merged cards standing for all the cards of `cards` (the finest level's), none
+/// below y = `ground_y`, into `out`: what [`merge_cards_into`] makes for the levels above the
+/// coarsest, for a renderer that draws the coarsest level with the species' leaf texture
+/// rather than a billboard cloud's atlas (the cloud's quads drawn with the leaf texture would
+/// show a leaf card where a cluster of leaves should be).
+pub fn merged_cards_into(cards: &TreeMesh, num_cards: usize, ground_y: f32, out: &mut TreeMesh) {
+    merge_cards_into(
+        cards,
+        num_cards,
+        ground_y,
+        &mut MergeScratch::default(),
+        out,
+    );
 }
 
 /// `num_cards` cards standing for all the cards of `cards` (quads of 4 vertices and 6 indices,

@@ -50,11 +50,21 @@ pub struct Mesher {
     fruit_centers: Vec<Vec3>,
     /// Parents and children of the internodes, for the topology.
     links: Links,
+    /// Whether the coarsest level's leaves are merged cards (as the other coarse levels')
+    /// rather than a billboard cloud: for a renderer that draws every level with the leaf
+    /// texture, so that it does not pay for clustering a cloud it never draws.
+    coarsest_as_cards: bool,
 }
 
 impl Mesher {
     pub fn new() -> Self {
         Mesher::default()
+    }
+
+    /// Makes the coarsest level's leaves merged cards instead of a billboard cloud (the
+    /// default) from the next build on.
+    pub fn set_coarsest_as_cards(&mut self, as_cards: bool) {
+        self.coarsest_as_cards = as_cards;
     }
 
     /// Builds the branch meshes of `levels` and the leaf and fruit buffers of `skeleton` into
@@ -104,16 +114,18 @@ impl Mesher {
             let num_cards = self.mesh_level(level, finest, num_fruit / 3, lod);
             if level == 0 {
                 lod.merged_leaves.clear();
+                lod.billboards = None;
+                lod.num_leaf_indices = 6 * num_cards;
             } else {
-                lod_leaves::merge_cards_into(
+                lod_leaves::coarse_leaves_into(
                     &meshes.leaves,
                     num_cards,
                     ground_y,
+                    level + 1 == LOD_TRIANGLE_FRACTIONS.len() && !self.coarsest_as_cards,
                     &mut self.merge_scratch,
-                    &mut lod.merged_leaves,
+                    lod,
                 );
             }
-            lod.num_leaf_indices = 6 * num_cards;
             lod.num_fruit_indices = num_fruit;
         }
         meshes.leaf_card.set(&params.leaves);

@@ -36,6 +36,7 @@
 //! Space: world metres, Y up, as the skeleton. All arrays are flat `[f32; N]` / `u32` vectors, ready
 //! to be cast to GPU buffers.
 
+pub mod billboard_cloud;
 mod branches;
 pub mod crown;
 mod lanes;
@@ -59,6 +60,7 @@ use crate::tree::{NodeId, Skeleton};
 
 pub use leaf_card::LeafCard;
 pub use leaves::{FruitParams, LeafParams};
+pub use lod_leaves::merged_cards_into;
 pub use looks::{
     BarkKind, BarkLook, FruitLook, LeafShape, Looks, Season, SeasonColors, TreeShade,
     build_tree_level, build_tree_meshes, build_tree_meshes_in, build_tree_meshes_with,
@@ -288,6 +290,10 @@ pub struct Lod {
     /// cards it stands for, so the crown keeps its silhouette instead of going bald. Empty at
     /// the finest level.
     pub merged_leaves: TreeMesh,
+    /// The coarsest level's layout of [`Lod::merged_leaves`] as a billboard cloud
+    /// ([`billboard_cloud`]): each quad drawn from a rectangle of one atlas holding the leaves
+    /// it stands for. `None` at the other levels, whose merged cards use the leaf texture.
+    pub billboards: Option<billboard_cloud::BillboardCloud>,
     /// This level draws the first `num_fruit_indices` of [`TreeMeshes::fruit`].
     pub num_fruit_indices: usize,
 }

@@ -141,7 +141,13 @@ pub fn assert_reimport_matches(path: &Path, meshes: &TreeMeshes) {
     );
     assert!(meshes.leaves.num_triangles() > 0, "the tree has leaves");
     let images = json["images"].as_array().expect("images");
-    assert_eq!(images.len(), 2, "bark and leaf images");
+    // A billboard-cloud level (the coarsest) carries its own leaf atlas.
+    let atlases = meshes
+        .lods
+        .iter()
+        .filter(|lod| lod.billboards.is_some() && lod.num_leaf_indices > 0)
+        .count();
+    assert_eq!(images.len(), 2 + atlases, "bark, leaf and atlas images");
     for image in images {
         let view = image["bufferView"].as_u64().expect("an embedded image") as usize;
         let decoded = image::load_from_memory(view_bytes(&json, &bin, view)).expect("a PNG");
