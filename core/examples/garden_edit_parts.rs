@@ -13,24 +13,10 @@ mod garden_stands;
 use garden_stands::{EDITS, alone, stand};
 #[path = "../benches/common/thread_cpu.rs"]
 mod thread_cpu;
-use thread_cpu::thread_cpu_ns;
+use thread_cpu::{cpu_ms, median_ms};
 
 const EDITED: usize = 4;
 const RUNS: usize = 15;
-
-fn median_ms(mut samples: Vec<f64>) -> f64 {
-    samples.sort_by(f64::total_cmp);
-    samples[samples.len() / 2]
-}
-
-fn cpu_ms(f: impl FnOnce()) -> f64 {
-    let start = thread_cpu_ns();
-    f();
-    match (start, thread_cpu_ns()) {
-        (Some(a), Some(b)) => (b - a) as f64 / 1e6,
-        _ => f64::NAN,
-    }
-}
 
 fn main() {
     let pool = rayon::ThreadPoolBuilder::new()

@@ -75,6 +75,20 @@ pub struct IterationStats {
     pub num_pruned_internodes: usize,
 }
 
+impl IterationStats {
+    /// Adds one more iteration's figures to these totals: counts add up, and `num_buds` is the
+    /// latest iteration's (the buds standing now).
+    pub fn accumulate(&mut self, s: IterationStats) {
+        self.num_buds = s.num_buds;
+        self.num_enabled_buds += s.num_enabled_buds;
+        self.num_points += s.num_points;
+        self.num_shoots += s.num_shoots;
+        self.num_new_internodes += s.num_new_internodes;
+        self.num_shed_internodes += s.num_shed_internodes;
+        self.num_pruned_internodes += s.num_pruned_internodes;
+    }
+}
+
 /// Summary figures of a tree.
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct TreeMetrics {
@@ -255,17 +269,10 @@ impl Tree {
     ) -> IterationStats {
         let mut total = IterationStats::default();
         for _ in 0..iterations {
-            let s = self.step(StepOptions {
+            total.accumulate(self.step(StepOptions {
                 autonomous: true,
                 scene,
-            });
-            total.num_buds = s.num_buds;
-            total.num_enabled_buds += s.num_enabled_buds;
-            total.num_points += s.num_points;
-            total.num_shoots += s.num_shoots;
-            total.num_new_internodes += s.num_new_internodes;
-            total.num_shed_internodes += s.num_shed_internodes;
-            total.num_pruned_internodes += s.num_pruned_internodes;
+            }));
         }
         total
     }

@@ -22,6 +22,24 @@ pub fn process_cpu_ns() -> Option<u64> {
     )
 }
 
+/// Milliseconds of this thread's CPU that `f` takes; NaN where the clock is missing.
+#[allow(dead_code)]
+pub fn cpu_ms(f: impl FnOnce()) -> f64 {
+    let start = thread_cpu_ns();
+    f();
+    match (start, thread_cpu_ns()) {
+        (Some(a), Some(b)) => (b - a) as f64 / 1e6,
+        _ => f64::NAN,
+    }
+}
+
+/// The median of timing samples (the upper one of an even count).
+#[allow(dead_code)]
+pub fn median_ms(mut samples: Vec<f64>) -> f64 {
+    samples.sort_by(f64::total_cmp);
+    samples[samples.len() / 2]
+}
+
 fn cpu_clock_ns(#[cfg(unix)] clock: libc::clockid_t) -> Option<u64> {
     #[cfg(unix)]
     {

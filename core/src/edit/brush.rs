@@ -358,20 +358,13 @@ pub fn grow_with_point_lifetime(
 ) -> IterationStats {
     let mut total = IterationStats::default();
     for _ in 0..iterations {
-        let s = step_with_point_lifetime(
+        total.accumulate(step_with_point_lifetime(
             tree,
             StepOptions {
                 autonomous: true,
                 scene,
             },
-        );
-        total.num_buds = s.num_buds;
-        total.num_enabled_buds += s.num_enabled_buds;
-        total.num_points += s.num_points;
-        total.num_shoots += s.num_shoots;
-        total.num_new_internodes += s.num_new_internodes;
-        total.num_shed_internodes += s.num_shed_internodes;
-        total.num_pruned_internodes += s.num_pruned_internodes;
+        ));
     }
     total
 }
