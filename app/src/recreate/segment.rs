@@ -36,13 +36,7 @@ impl CrownMask {
 
     /// 8-bit grey PNG: 255 on the crown.
     pub fn save_png(&self, path: &std::path::Path) -> anyhow::Result<()> {
-        let pixels: Vec<u8> = self
-            .inside
-            .iter()
-            .map(|&v| if v { 255 } else { 0 })
-            .collect();
-        image::save_buffer(path, &pixels, self.width, self.height, image::ColorType::L8)?;
-        Ok(())
+        super::silhouette::save_mask_png(path, &self.inside, self.width, self.height)
     }
 
     pub fn area_px(&self) -> usize {

@@ -138,14 +138,20 @@ impl Silhouette {
 
     /// 8-bit grey PNG: 255 on the model.
     pub fn save_png(&self, path: &std::path::Path) -> anyhow::Result<()> {
-        let pixels: Vec<u8> = self
-            .inside
-            .iter()
-            .map(|&v| if v { 255 } else { 0 })
-            .collect();
-        image::save_buffer(path, &pixels, self.width, self.height, image::ColorType::L8)?;
-        Ok(())
+        save_mask_png(path, &self.inside, self.width, self.height)
     }
+}
+
+/// A `width` × `height` mask as an 8-bit grey PNG: 255 where `inside`, 0 elsewhere.
+pub(crate) fn save_mask_png(
+    path: &std::path::Path,
+    inside: &[bool],
+    width: u32,
+    height: u32,
+) -> anyhow::Result<()> {
+    let pixels: Vec<u8> = inside.iter().map(|&v| if v { 255 } else { 0 }).collect();
+    image::save_buffer(path, &pixels, width, height, image::ColorType::L8)?;
+    Ok(())
 }
 
 /// Texture coordinates of a triangle's corners and the texture's alpha mask.

@@ -34,6 +34,7 @@ use glam::{Vec2, Vec3};
 use image::{Rgba, RgbaImage};
 
 use super::leaves::push_quad_indices;
+use super::lod_leaves::morton3;
 use super::silhouette::SILHOUETTE_HEIGHT_PX;
 use super::{TreeMesh, TreeMeshes};
 
@@ -572,18 +573,6 @@ fn pack(frames: &[Frame], order: &mut Vec<u32>, cloud: &mut BillboardCloud) -> O
         }
         texel_m *= 1.1;
     }
-}
-
-/// Interleaves the low [`OCTREE_BITS`] bits of x, y and z (x lowest).
-fn morton3(x: u32, y: u32, z: u32) -> u32 {
-    fn spread(mut v: u32) -> u32 {
-        v &= 0x3ff;
-        v = (v | (v << 16)) & 0x0300_00ff;
-        v = (v | (v << 8)) & 0x0300_f00f;
-        v = (v | (v << 4)) & 0x030c_30c3;
-        (v | (v << 2)) & 0x0924_9249
-    }
-    spread(x) | (spread(y) << 1) | (spread(z) << 2)
 }
 
 /// The atlas of level `lod` of `meshes`, drawn from the leaf cards' texture `card_texture`

@@ -162,8 +162,9 @@ pub(crate) fn merge_cards_into(
     push_quad_indices(out, 0, num_cards);
 }
 
-/// Interleaves the low [`MORTON_BITS`] bits of x, y and z (x lowest).
-fn morton3(x: u32, y: u32, z: u32) -> u32 {
+/// Interleaves the low 10 bits ([`MORTON_BITS`]) of x, y and z (x lowest); the billboard
+/// cloud's octree keys use it too.
+pub(super) fn morton3(x: u32, y: u32, z: u32) -> u32 {
     fn spread(mut v: u32) -> u32 {
         v &= 0x3ff;
         v = (v | (v << 16)) & 0x0300_00ff;

@@ -87,19 +87,7 @@ pub(crate) fn distribute(tree: &Tree, scratch: &mut Scratch, every_node: bool) -
     };
     let mut v_max = 0.0f32;
     for i in 0..n {
-        let (qm, ql) = (q_main[i], q_lateral[i]);
-        let denominator = lambda * qm + (1.0 - lambda) * ql;
-        let (vm, vl) = if denominator > 0.0 {
-            let v = vigor[i];
-            (
-                v * lambda * qm / denominator,
-                v * (1.0 - lambda) * ql / denominator,
-            )
-        } else {
-            (0.0, 0.0)
-        };
-        // v_l shared among lateral elements in proportion to their Q.
-        let lateral_share = if ql > 0.0 { vl / ql } else { 0.0 };
+        let (vm, lateral_share) = split_vigor(vigor[i], q_main[i], q_lateral[i], lambda);
         let has_main_child = main_child[i] != NO_NODE;
         if has_main_child {
             vigor[main_child[i] as usize] = vm;
@@ -209,18 +197,7 @@ fn distribute_along_paths(tree: &Tree, scratch: &mut Scratch) -> Option<f32> {
     let mut v_max = 0.0f32;
     for &i in path_nodes.iter() {
         let i = i as usize;
-        let (qm, ql) = (q_main[i], q_lateral[i]);
-        let denominator = lambda * qm + (1.0 - lambda) * ql;
-        let (vm, vl) = if denominator > 0.0 {
-            let v = vigor[i];
-            (
-                v * lambda * qm / denominator,
-                v * (1.0 - lambda) * ql / denominator,
-            )
-        } else {
-            (0.0, 0.0)
-        };
-        let lateral_share = if ql > 0.0 { vl / ql } else { 0.0 };
+        let (vm, lateral_share) = split_vigor(vigor[i], q_main[i], q_lateral[i], lambda);
         let has_main_child = main_child[i] != NO_NODE;
         if has_main_child && on_path[main_child[i] as usize] {
             vigor[main_child[i] as usize] = vm;
@@ -244,6 +221,23 @@ fn distribute_along_paths(tree: &Tree, scratch: &mut Scratch) -> Option<f32> {
         }
     }
     Some(v_max)
+}
+
+/// The Borchert–Honda split of a node's vigor `v` (Pałubicki et al. 2009): the main child's share
+/// v_m, and the lateral elements' share per unit of Q (v_l / Q_l, so each lateral element gets
+/// that times its own Q).
+#[inline]
+fn split_vigor(v: f32, qm: f32, ql: f32, lambda: f32) -> (f32, f32) {
+    let denominator = lambda * qm + (1.0 - lambda) * ql;
+    let (vm, vl) = if denominator > 0.0 {
+        (
+            v * lambda * qm / denominator,
+            v * (1.0 - lambda) * ql / denominator,
+        )
+    } else {
+        (0.0, 0.0)
+    };
+    (vm, if ql > 0.0 { vl / ql } else { 0.0 })
 }
 
 /// Step 7: lateral branches (born before this iteration) whose vigor per internode, with vigor in
