@@ -48,6 +48,58 @@ pub struct LeafParams {
     pub turn_rate: f32,
     /// Tropism target T of the blade normal: towards the light.
     pub light_direction: [f32; 3],
+    /// The fine shoots that carry the leaves off their branch (none by default).
+    #[serde(default, skip_serializing_if = "crate::is_default")]
+    pub short_shoots: ShortShoots,
+}
+
+/// Leaf-bearing shoots finer than the skeleton draws (Longay 2014 app. C.1.1 puts leaves on
+/// every thin branch; a real crown carries most of them on twigs and spurs below the
+/// skeleton's resolution). A silver birch hangs its leaves on long pendulous twigs from the
+/// arching limbs; a Lombardy poplar holds them on short upright spurs all along its older
+/// branches, not only at the tips of its whips. Each leaf (or spray card) sits at a point of
+/// its shoot, a hash of the leaf choosing how far out; the shoot leaves its branch towards
+/// the branch's side that the leaf faces and heads at its set-point angle from vertical.
+/// Lengths in metres, angles in radians. The default (zero length, no spurs) keeps every
+/// leaf on its branch.
+#[derive(Clone, Debug, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default)]
+pub struct ShortShoots {
+    /// Shoot length: leaves sit from the branch surface to this far out along the shoot.
+    pub length: f32,
+    /// Set-point angle of a shoot from vertical (0 up, π/2 level, π hanging).
+    pub angle_from_vertical: f32,
+    /// Branches from `LeafParams::max_branch_diameter` up to this diameter bear spurs too.
+    pub max_spur_branch_diameter: f32,
+    /// Leaves per metre of those spur-bearing branches.
+    pub spur_leaves_per_metre: f32,
+}
+
+impl ShortShoots {
+    /// Leaves per metre of a branch of `diameter` (the leafy branches' density `leafy`), or
+    /// `None` if it bears none.
+    fn leaves_per_metre(&self, diameter: f32, max_leafy_diameter: f32, leafy: f32) -> Option<f32> {
+        if diameter < max_leafy_diameter {
+            Some(leafy)
+        } else if diameter < self.max_spur_branch_diameter && self.spur_leaves_per_metre > 0.0 {
+            Some(self.spur_leaves_per_metre)
+        } else {
+            None
+        }
+    }
+
+    /// The slot `slot` moved out along its shoot, `reach` (0..1) of the shoot's length: the
+    /// shoot leaves on the slot's side of the branch at the set-point angle. The petiole keeps
+    /// the frame its branch gives it: leaves along a shoot face as the branch's would (a
+    /// spray card turned about a hanging twig would lie flat and show its edge to the side).
+    fn carry(&self, slot: &mut Attachment, reach: f32) {
+        let horizontal = Vec3::new(slot.radial.x, 0.0, slot.radial.z)
+            .try_normalize()
+            .unwrap_or_else(|| any_perpendicular(Vec3::Y));
+        let (sin, cos) = self.angle_from_vertical.sin_cos();
+        let shoot = cos * Vec3::Y + sin * horizontal;
+        slot.point += shoot * (self.length * reach);
+    }
 }
 
 impl Default for LeafParams {
@@ -65,6 +117,7 @@ impl Default for LeafParams {
             bend_rate: 40.0,
             turn_rate: 10.0,
             light_direction: [0.0, 1.0, 0.0],
+            short_shoots: ShortShoots::default(),
         }
     }
 }
@@ -181,12 +234,17 @@ pub(crate) fn build_leaves_into(
     let spiral = &mut scratch.spiral;
     let card = &mut scratch.card;
     card.set(params);
-    let cards_per_metre = params.leaves_per_metre / card.num_leaves() as f32;
+    let leaves_per_card = card.num_leaves() as f32;
+    let shoots = &params.short_shoots;
     for (index, node) in nodes.iter().enumerate() {
-        if node.diameter >= params.max_branch_diameter {
+        let Some(leaves_per_metre) = shoots.leaves_per_metre(
+            node.diameter,
+            params.max_branch_diameter,
+            params.leaves_per_metre,
+        ) else {
             continue;
-        }
-        let expected = cards_per_metre * node.length;
+        };
+        let expected = leaves_per_metre / leaves_per_card * node.length;
         let jitter = hash_unit(seed ^ ((index as u64) << 20));
         let count = ((expected + jitter) as u32).min(MAX_LEAVES_PER_INTERNODE);
         if count == 0 {
@@ -216,6 +274,11 @@ pub(crate) fn build_leaves_into(
                 light: 0.0,
             };
             slots.push(slot);
+        }
+    }
+    if shoots.length > 0.0 {
+        for (k, slot) in slots.iter_mut().enumerate() {
+            shoots.carry(slot, hash_unit(seed ^ 0x5400_7000 ^ ((k as u64) << 24)));
         }
     }
     // The ambient light at every attachment, in a pass of its own: a call through the callback
@@ -472,6 +535,74 @@ fn push_icosahedron(mesh: &mut TreeMesh, center: Vec3, radius: f32, light: f32) 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::geometry::synthetic::{branching_skeleton, crown_ambient};
+
+    fn leaves_with(shoots: ShortShoots) -> (TreeMesh, Vec<NodeGeom>) {
+        let skeleton = branching_skeleton(3_000, 5);
+        let mut nodes = Vec::new();
+        NodeGeom::collect_into(&skeleton, &mut nodes);
+        let params = LeafParams {
+            leaves_per_metre: 60.0,
+            leaves_per_card: 4,
+            short_shoots: shoots,
+            ..LeafParams::default()
+        };
+        let ambient = crown_ambient(Vec3::Y, 1.5);
+        (build_leaves(&skeleton, &params, 3, &ambient), nodes)
+    }
+
+    fn mean_height(mesh: &TreeMesh) -> f32 {
+        mesh.positions.iter().map(|p| p[1]).sum::<f32>() / mesh.positions.len() as f32
+    }
+
+    #[test]
+    fn hanging_short_shoots_lower_the_leaves_by_half_their_length_keeping_their_number() {
+        let (on_branches, _) = leaves_with(ShortShoots::default());
+        let length = 0.2;
+        let (hanging, _) = leaves_with(ShortShoots {
+            length,
+            angle_from_vertical: std::f32::consts::PI,
+            ..ShortShoots::default()
+        });
+        assert_eq!(hanging.positions.len(), on_branches.positions.len());
+        // Reach is uniform along the shoot: the leaves drop half its length on average (a
+        // little less where the ground lifts a leaf).
+        let drop = mean_height(&on_branches) - mean_height(&hanging);
+        assert!(
+            (0.8 * 0.5 * length..=0.5 * length * 1.05).contains(&drop),
+            "leaves dropped {drop} m on shoots of {length} m"
+        );
+    }
+
+    #[test]
+    fn spurs_leaf_the_branches_up_to_their_diameter_at_their_own_density() {
+        let (on_branches, nodes) = leaves_with(ShortShoots::default());
+        let leafy = LeafParams::default().max_branch_diameter;
+        let max_spur = 3.0 * leafy;
+        let spur_leaves_per_metre = 30.0;
+        let (spurred, _) = leaves_with(ShortShoots {
+            max_spur_branch_diameter: max_spur,
+            spur_leaves_per_metre,
+            ..ShortShoots::default()
+        });
+        let spur_metres: f32 = nodes
+            .iter()
+            .filter(|n| (leafy..max_spur).contains(&n.diameter))
+            .map(|n| n.length)
+            .sum();
+        assert!(spur_metres > 1.0, "only {spur_metres} m of spur-bearing branch");
+        let extra_cards = (spurred.positions.len() - on_branches.positions.len()) / 4;
+        let expected = spur_leaves_per_metre / 4.0 * spur_metres;
+        assert!(
+            (extra_cards as f32 - expected).abs() <= 0.05 * expected + 2.0,
+            "{extra_cards} cards on spurs, expected about {expected}"
+        );
+        let (none_dense, _) = leaves_with(ShortShoots {
+            max_spur_branch_diameter: max_spur,
+            ..ShortShoots::default()
+        });
+        assert_eq!(none_dense.positions.len(), on_branches.positions.len());
+    }
 
     #[test]
     fn rounding_without_round_equals_round_for_halves_integers_extremes_and_nan() {

@@ -11,7 +11,7 @@ use std::str::FromStr;
 use glam::Vec3;
 use serde::{Deserialize, Serialize};
 
-use super::{FruitParams, LeafParams, MeshParams};
+use super::{FruitParams, LeafParams, MeshParams, ShortShoots};
 use crate::growth::Tree;
 use crate::species::Species;
 
@@ -190,6 +190,19 @@ pub struct Looks {
     /// Leaves drawn on one card (a spray of small leaves, a needle shoot; see
     /// [`super::leaf_card`]).
     pub leaves_per_card: u32,
+    /// The fine shoots that carry the leaves off their branches ([`super::ShortShoots`]):
+    /// their length, metres (0, the default, keeps leaves on the branch)...
+    #[serde(skip_serializing_if = "crate::is_default")]
+    pub short_shoot_length_m: f32,
+    /// ... and their set-point angle from vertical, degrees (0 up, 90 level, 180 hanging).
+    #[serde(skip_serializing_if = "crate::is_default")]
+    pub short_shoot_angle_deg: f32,
+    /// Branches up to this many tip diameters (beyond `leafy_diameters`) bear leafy spurs
+    /// along them, at `spur_leaves_per_metre`; 0 (the default) for none.
+    #[serde(skip_serializing_if = "crate::is_default")]
+    pub spur_diameters: f32,
+    #[serde(skip_serializing_if = "crate::is_default")]
+    pub spur_leaves_per_metre: f32,
     /// Keeps its leaves in winter (conifers); deciduous trees stand leafless.
     pub evergreen: bool,
     pub leaf_color: SeasonColors,
@@ -208,6 +221,10 @@ impl Default for Looks {
             leafy_diameters: 10.0,
             leaf_insertion_deg: None,
             leaves_per_card: 8,
+            short_shoot_length_m: 0.0,
+            short_shoot_angle_deg: 0.0,
+            spur_diameters: 0.0,
+            spur_leaves_per_metre: 0.0,
             evergreen: false,
             leaf_color: SeasonColors::default(),
             bark: BarkLook::default(),
@@ -225,6 +242,10 @@ impl Looks {
             ("looks.leaf_width", self.leaf_width, 0.0005, 2.0),
             ("looks.leaves_per_metre", self.leaves_per_metre, 0.0, 2000.0),
             ("looks.leafy_diameters", self.leafy_diameters, 1.0, 1000.0),
+            ("looks.short_shoot_length_m", self.short_shoot_length_m, 0.0, 5.0),
+            ("looks.short_shoot_angle_deg", self.short_shoot_angle_deg, 0.0, 180.0),
+            ("looks.spur_diameters", self.spur_diameters, 0.0, 1000.0),
+            ("looks.spur_leaves_per_metre", self.spur_leaves_per_metre, 0.0, 2000.0),
             (
                 "looks.bark.dark_base_diameters",
                 self.bark.dark_base_diameters,
@@ -323,6 +344,16 @@ pub fn mesh_params_in(species: &Species, season: Season) -> MeshParams {
             insertion_angle: look
                 .leaf_insertion_deg
                 .map_or(LeafParams::default().insertion_angle, f32::to_radians),
+            short_shoots: ShortShoots {
+                length: look.short_shoot_length_m,
+                angle_from_vertical: look.short_shoot_angle_deg.to_radians(),
+                max_spur_branch_diameter: species.tip_diameter_m * look.spur_diameters,
+                spur_leaves_per_metre: if leaf_color.is_some() {
+                    look.spur_leaves_per_metre
+                } else {
+                    0.0
+                },
+            },
             ..LeafParams::default()
         },
         fruit: fruit.map(|f| FruitParams {
@@ -469,8 +500,14 @@ mod tests {
     #[test]
     fn bad_look_values_are_refused_naming_the_field() {
         type Damage = fn(&mut Looks);
-        let cases: [(&str, Damage); 6] = [
+        let cases: [(&str, Damage); 8] = [
             ("looks.leaf_length", |l| l.leaf_length = f32::NAN),
+            ("looks.short_shoot_angle_deg", |l| {
+                l.short_shoot_angle_deg = 200.0
+            }),
+            ("looks.spur_leaves_per_metre", |l| {
+                l.spur_leaves_per_metre = -5.0
+            }),
             ("looks.leaf_insertion_deg", |l| {
                 l.leaf_insertion_deg = Some(200.0)
             }),

@@ -59,7 +59,7 @@ use serde::{Deserialize, Serialize};
 use crate::tree::{NodeId, Skeleton};
 
 pub use leaf_card::LeafCard;
-pub use leaves::{FruitParams, LeafParams};
+pub use leaves::{FruitParams, LeafParams, ShortShoots};
 pub use lod_leaves::merged_cards_into;
 pub use looks::{
     BarkKind, BarkLook, FruitLook, LeafShape, Looks, Season, SeasonColors, TreeShade,
