@@ -590,7 +590,10 @@ mod tests {
             .filter(|n| (leafy..max_spur).contains(&n.diameter))
             .map(|n| n.length)
             .sum();
-        assert!(spur_metres > 1.0, "only {spur_metres} m of spur-bearing branch");
+        assert!(
+            spur_metres > 1.0,
+            "only {spur_metres} m of spur-bearing branch"
+        );
         let extra_cards = (spurred.positions.len() - on_branches.positions.len()) / 4;
         let expected = spur_leaves_per_metre / 4.0 * spur_metres;
         assert!(

@@ -242,10 +242,25 @@ impl Looks {
             ("looks.leaf_width", self.leaf_width, 0.0005, 2.0),
             ("looks.leaves_per_metre", self.leaves_per_metre, 0.0, 2000.0),
             ("looks.leafy_diameters", self.leafy_diameters, 1.0, 1000.0),
-            ("looks.short_shoot_length_m", self.short_shoot_length_m, 0.0, 5.0),
-            ("looks.short_shoot_angle_deg", self.short_shoot_angle_deg, 0.0, 180.0),
+            (
+                "looks.short_shoot_length_m",
+                self.short_shoot_length_m,
+                0.0,
+                5.0,
+            ),
+            (
+                "looks.short_shoot_angle_deg",
+                self.short_shoot_angle_deg,
+                0.0,
+                180.0,
+            ),
             ("looks.spur_diameters", self.spur_diameters, 0.0, 1000.0),
-            ("looks.spur_leaves_per_metre", self.spur_leaves_per_metre, 0.0, 2000.0),
+            (
+                "looks.spur_leaves_per_metre",
+                self.spur_leaves_per_metre,
+                0.0,
+                2000.0,
+            ),
             (
                 "looks.bark.dark_base_diameters",
                 self.bark.dark_base_diameters,
