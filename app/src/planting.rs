@@ -376,8 +376,9 @@ mod tests {
         };
         // Rigid, and with a world whose unit is 0.63 m (a tracker 1.59× too large).
         for metres_per_unit in [1.0, 0.63] {
-            let world_from_tree =
-                world_from_tree_at(Vec3::new(0.5, 0.0, -0.3), &ground, metres_per_unit);
+            // A base on the tilted ground.
+            let base = Vec3::new(0.5, -0.034, -0.3);
+            let world_from_tree = world_from_tree_at(base, &ground, metres_per_unit);
             assert!((metres_per_unit_of(&world_from_tree) - metres_per_unit).abs() < 1e-6);
             let tree_camera = camera_in_tree(&camera, &world_from_tree.inverse());
             let rotation = glam::Mat3::from_mat4(tree_camera.world_from_camera);
@@ -400,7 +401,8 @@ mod tests {
             }
             let ground_in_tree = ground_in_tree(&ground, &world_from_tree.inverse());
             assert!(ground_in_tree.normal.distance(Vec3::Y) < 1e-5);
-            assert!(ground_in_tree.point.y.abs() < 1e-5);
+            // The trunk base (tree space's origin) is on it.
+            assert!(ground_in_tree.point.dot(ground_in_tree.normal).abs() < 1e-5);
         }
     }
 
