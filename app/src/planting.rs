@@ -1,7 +1,11 @@
 //! Where the tree stands and how the real scene shapes it.
 //!
 //! **Planting.** The tree is grown in its own space (metres, Y up, the trunk base at the origin);
-//! `world_from_tree` places it in the tracked world. A tap on the ground plane plants it where
+//! `world_from_tree = T(base) · R(ground up) · S(1 / metres_per_unit)` places it in the tracked
+//! world, whose unit is the tracker's, at the design's scale ([`crate::scale::TreeScale`]): the
+//! camera seen from tree space is kept rigid (so depths there are metres), the ground's normal
+//! is renormalised, and the scene's lowest voxel layer is converted to metres. A tap on the
+//! ground plane plants it where
 //! the ray from the tapped pixel through the frame's camera meets the plane, and dragging the
 //! trunk base moves it. Everything that meets the world goes through that transform: the design
 //! state sees the camera in tree space (so picking and the brush plane are in tree space), the

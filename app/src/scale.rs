@@ -5,8 +5,11 @@
 //! The tracker's world is fixed once, in units of its first guess (the holding height at its
 //! first map). [`ScaleState::metres_per_unit`] is one factor on that world about its origin (on
 //! the ground); [`ScaleState::observe`] and the picks always take the tracker's own (unscaled)
-//! frames. The design does not yet multiply its camera translations, tracked points and plane by
-//! it (the tree is grown in the tracker's world, whose unit is a metre to the first map's error).
+//! frames. The design applies it to the trees, not to the world: tree space is metres and each
+//! tree's `world_from_tree` carries S(1 / metres per unit) of the design's [`TreeScale`], taken
+//! when the first tree is planted and changed only by an explicit event (a holding height, a
+//! known length marked; never the camera height's frame-to-frame refinement), which rescales
+//! every tree about its trunk base.
 //!
 //! The design's part is [`DesignScale`]: every shown frame goes to [`DesignScale::observe`]; the
 //! camera-height field sends `InputEvent::HoldingHeight`; choosing the known-length or measure
