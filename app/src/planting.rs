@@ -1,7 +1,11 @@
 //! Where the tree stands and how the real scene shapes it.
 //!
 //! **Planting.** The tree is grown in its own space (metres, Y up, the trunk base at the origin);
-//! `world_from_tree` places it in the tracked world. A tap on the ground plane plants it where
+//! `world_from_tree = T(base) · R(ground up) · S(1 / metres_per_unit)` places it in the tracked
+//! world, whose unit is the tracker's, at the design's scale ([`crate::scale::TreeScale`]): the
+//! camera seen from tree space is kept rigid (so depths there are metres), the ground's normal
+//! is renormalised, and the scene's lowest voxel layer is converted to metres. A tap on the
+//! ground plane plants it where
 //! the ray from the tapped pixel through the frame's camera meets the plane, and dragging the
 //! trunk base moves it. Everything that meets the world goes through that transform: the design
 //! state sees the camera in tree space (so picking and the brush plane are in tree space), the
@@ -20,6 +24,7 @@ use sylva_tracking::depth_mesh::Observation;
 use sylva_tracking::occupancy::OccupancyMap;
 
 use crate::render::{GroundPlane, Intrinsics, OccluderMesh, ViewCamera};
+use crate::scale::TreeScale;
 use crate::scene_tracking::SceneOccupancy;
 use crate::state::{DesignState, PICK_RADIUS_PX};
 
@@ -81,19 +86,53 @@ pub fn ground_point_at_pixel(
     (t > 0.0 && t.is_finite()).then(|| origin + direction * t)
 }
 
-/// The tree planted at `point` on `ground`, its Y axis along the ground's normal.
-pub fn world_from_tree_at(point: Vec3, ground: &GroundPlane) -> Affine3A {
+/// The tree planted at `point` on `ground`, its Y axis along the ground's normal, at
+/// `metres_per_unit` metres per unit of the world (tree space is metres):
+/// `world_from_tree = T(point) · R(ground up) · S(1 / metres_per_unit)`.
+pub fn world_from_tree_at(point: Vec3, ground: &GroundPlane, metres_per_unit: f32) -> Affine3A {
     let up = ground.normal.try_normalize().unwrap_or(Vec3::Y);
-    Affine3A::from_rotation_translation(Quat::from_rotation_arc(Vec3::Y, up), point)
+    Affine3A::from_scale_rotation_translation(
+        Vec3::splat(1.0 / metres_per_unit),
+        Quat::from_rotation_arc(Vec3::Y, up),
+        point,
+    )
 }
 
-/// `camera` (in the world) seen from tree space.
+/// Metres per world unit of a `world_from_tree` (its uniform scale's inverse; 1 for a rigid
+/// placement).
+pub fn metres_per_unit_of(world_from_tree: &Affine3A) -> f32 {
+    1.0 / world_from_tree.matrix3.x_axis.length()
+}
+
+/// A uniform scale of the world by `factor` about `centre` (what a new design scale does to
+/// where trees stand: the centre stays, the rest moves).
+pub fn world_scaled_about(centre: Vec3, factor: f32) -> Affine3A {
+    Affine3A::from_translation(centre)
+        * Affine3A::from_scale(Vec3::splat(factor))
+        * Affine3A::from_translation(-centre)
+}
+
+/// `camera` (in the world) seen from tree space: a rigid camera (rotation as in the world,
+/// position moved by `tree_from_world`), so it projects every tree point to the pixel where
+/// the world camera projects the point's place in the world, and its depths are metres. Near and
+/// far are scaled with the world.
 pub fn camera_in_tree(camera: &ViewCamera, tree_from_world: &Affine3A) -> ViewCamera {
     if *tree_from_world == Affine3A::IDENTITY {
         return *camera;
     }
+    let metres_per_unit = tree_from_world.matrix3.x_axis.length();
+    let rotation = Mat4::from(*tree_from_world) * camera.world_from_camera;
+    let position = tree_from_world.transform_point3(camera.position());
+    let column = |c: glam::Vec4| (c.truncate() / metres_per_unit).extend(0.0);
     ViewCamera {
-        world_from_camera: Mat4::from(*tree_from_world) * camera.world_from_camera,
+        world_from_camera: Mat4::from_cols(
+            column(rotation.x_axis),
+            column(rotation.y_axis),
+            column(rotation.z_axis),
+            position.extend(1.0),
+        ),
+        near: camera.near * metres_per_unit,
+        far: camera.far * metres_per_unit,
         ..*camera
     }
 }
@@ -113,15 +152,16 @@ pub fn occluder_in_tree(occluder: &OccluderMesh, tree_from_world: &Affine3A) -> 
     }
 }
 
-/// The ground plane (in the world) in tree space.
+/// The ground plane (in the world) in tree space (its normal of unit length: the placement
+/// carries a scale).
 pub fn ground_in_tree(ground: &GroundPlane, tree_from_world: &Affine3A) -> GroundPlane {
     if *tree_from_world == Affine3A::IDENTITY {
         return *ground;
     }
-    // A rigid motion keeps the normal's length.
+    let normal = tree_from_world.transform_vector3(ground.normal);
     GroundPlane {
         point: tree_from_world.transform_point3(ground.point),
-        normal: tree_from_world.transform_vector3(ground.normal),
+        normal: normal.try_normalize().unwrap_or(normal),
     }
 }
 
@@ -160,10 +200,13 @@ pub(crate) fn tree_scene(
     world_from_tree: Option<Affine3A>,
 ) -> Option<TreeScene<'_>> {
     let map = occupancy.as_ref()?.map();
+    let world_from_tree = world_from_tree?;
+    // The voxel is sized in the tracker's unit; the clearance is in tree space (metres).
+    let voxel_size = sylva_tracking::occupancy::OccupancyConfig::default().voxel_size_m;
     (map.num_keyframes() > 0).then_some(TreeScene {
         map,
-        world_from_tree: world_from_tree?,
-        ground_clearance_m: sylva_tracking::occupancy::OccupancyConfig::default().voxel_size_m,
+        world_from_tree,
+        ground_clearance_m: voxel_size * metres_per_unit_of(&world_from_tree),
     })
 }
 
@@ -182,6 +225,13 @@ impl DesignState {
         self.ground = ground;
         self.scale
             .observe(intrinsics, world_from_camera, ground, observations);
+        if self.tree_scale == TreeScale::Awaiting
+            && self.is_planted()
+            && let Some(scale) = self.scale.state.current()
+        {
+            // Planted before there was a scale: the first one is taken (once).
+            self.set_tree_scale(TreeScale::Metric(scale));
+        }
         self.occupancy
             .get_or_insert_with(|| SceneOccupancy::new(intrinsics))
             .observe(observations, world_from_camera, ground.is_some());
@@ -235,10 +285,58 @@ impl DesignState {
         let Some(point) = ground_point_at_pixel(&camera, &ground, pixel) else {
             return false;
         };
-        self.world_from_tree = Some(world_from_tree_at(point, &ground));
+        if !self.is_planted() {
+            // The design's scale is taken when its first tree is planted.
+            self.tree_scale = self
+                .scale
+                .state
+                .current()
+                .map_or(TreeScale::Awaiting, TreeScale::Metric);
+        }
+        let metres_per_unit = self.tree_scale.metres_per_unit() as f32;
+        self.world_from_tree = Some(world_from_tree_at(point, &ground, metres_per_unit));
         self.update_tree_camera();
         self.changed();
         true
+    }
+
+    /// An explicit scale event (a holding height entered, a known length marked): the design
+    /// takes the current scale (nothing before planting, or while there is no scale).
+    pub(crate) fn adopt_current_scale(&mut self) {
+        if let (true, Some(scale)) = (self.is_planted(), self.scale.state.current()) {
+            self.set_tree_scale(TreeScale::Metric(scale));
+        }
+    }
+
+    /// Places every tree at `scale`: each keeps its size in metres (tree space does not change)
+    /// and is scaled in the world about its trunk base, so it changes size in the image. A
+    /// garden is scaled as one about its first tree's base (the garden's layout is metres in
+    /// garden space), so the other trees' bases move with it.
+    pub(crate) fn set_tree_scale(&mut self, scale: TreeScale) {
+        let factor = (self.tree_scale.metres_per_unit() / scale.metres_per_unit()) as f32;
+        self.tree_scale = scale;
+        let Some(world_from_tree) = self.world_from_tree else {
+            return;
+        };
+        if !(factor.is_finite() && factor > 0.0) || (factor - 1.0).abs() < 1e-7 {
+            return;
+        }
+        let centre = self
+            .garden_origin_in_world()
+            .unwrap_or(Vec3::from(world_from_tree.translation));
+        let world_from_old = world_scaled_about(centre, factor);
+        self.world_from_tree = Some(world_from_old * world_from_tree);
+        self.rescale_garden(&world_from_old);
+        self.update_tree_camera();
+        self.changed();
+    }
+
+    /// The status line: the scale's source and uncertainty, and what the tree is drawn at.
+    pub fn scale_status(&self) -> String {
+        match self.is_planted() {
+            true => format!("{} · {}", self.scale.state.status(), self.tree_scale.status()),
+            false => self.scale.state.status(),
+        }
     }
 
     /// A touch starting on the trunk base drags the tree.
@@ -276,14 +374,48 @@ mod tests {
     fn the_camera_seen_from_tree_space_projects_tree_points_where_the_world_ones_were() {
         let intrinsics = Intrinsics::from_fov(640, 480, 60f32.to_radians());
         let camera = ViewCamera::looking_at(intrinsics, Vec3::new(0.0, 1.5, 3.0), Vec3::ZERO);
+        let ground = GroundPlane {
+            point: Vec3::ZERO,
+            normal: Vec3::new(0.05, 1.0, -0.03).normalize(),
+        };
+        // Rigid, and with a world whose unit is 0.63 m (a tracker 1.59× too large).
+        for metres_per_unit in [1.0, 0.63] {
+            // A base on the tilted ground.
+            let base = Vec3::new(0.5, -0.034, -0.3);
+            let world_from_tree = world_from_tree_at(base, &ground, metres_per_unit);
+            assert!((metres_per_unit_of(&world_from_tree) - metres_per_unit).abs() < 1e-6);
+            let tree_camera = camera_in_tree(&camera, &world_from_tree.inverse());
+            let rotation = glam::Mat3::from_mat4(tree_camera.world_from_camera);
+            assert!(
+                (rotation.transpose() * rotation).abs_diff_eq(glam::Mat3::IDENTITY, 1e-5),
+                "the tree camera is rigid"
+            );
+            for point_in_tree in [Vec3::new(0.0, 1.0, 0.0), Vec3::new(0.4, 2.5, -0.7)] {
+                let point_in_world = world_from_tree.transform_point3(point_in_tree);
+                let a = tree_camera.pixel_from_world(point_in_tree).unwrap();
+                let b = camera.pixel_from_world(point_in_world).unwrap();
+                assert!(a.distance(b) < 1e-3, "{a} vs {b} at {metres_per_unit} m/unit");
+                // Depths in tree space are metres: the world's depth times the scale.
+                let depth_m = tree_camera.depth_of(point_in_tree);
+                let depth_units = camera.depth_of(point_in_world);
+                assert!(
+                    (depth_m - depth_units * metres_per_unit).abs() < 1e-4,
+                    "{depth_m} m vs {depth_units} units"
+                );
+            }
+            let ground_in_tree = ground_in_tree(&ground, &world_from_tree.inverse());
+            assert!(ground_in_tree.normal.distance(Vec3::Y) < 1e-5);
+            // The trunk base (tree space's origin) is on it.
+            assert!(ground_in_tree.point.dot(ground_in_tree.normal).abs() < 1e-5);
+        }
+    }
+
+    #[test]
+    fn a_world_scale_about_the_base_keeps_the_base_and_sizes_the_tree() {
         let ground = GroundPlane::default();
-        let world_from_tree = world_from_tree_at(Vec3::new(0.5, 0.0, -0.3), &ground);
-        let tree_camera = camera_in_tree(&camera, &world_from_tree.inverse());
-        let top_in_tree = Vec3::new(0.0, 1.0, 0.0);
-        let a = tree_camera.pixel_from_world(top_in_tree).unwrap();
-        let b = camera
-            .pixel_from_world(world_from_tree.transform_point3(top_in_tree))
-            .unwrap();
-        assert!(a.distance(b) < 1e-3, "{a} vs {b}");
+        let base = Vec3::new(0.5, 0.0, -0.3);
+        let before = world_from_tree_at(base, &ground, 1.0);
+        let after = world_scaled_about(base, 1.0 / 0.63) * before;
+        assert!(after.abs_diff_eq(world_from_tree_at(base, &ground, 0.63), 1e-6));
     }
 }

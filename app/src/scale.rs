@@ -5,8 +5,11 @@
 //! The tracker's world is fixed once, in units of its first guess (the holding height at its
 //! first map). [`ScaleState::metres_per_unit`] is one factor on that world about its origin (on
 //! the ground); [`ScaleState::observe`] and the picks always take the tracker's own (unscaled)
-//! frames. The design does not yet multiply its camera translations, tracked points and plane by
-//! it (the tree is grown in the tracker's world, whose unit is a metre to the first map's error).
+//! frames. The design applies it to the trees, not to the world: tree space is metres and each
+//! tree's `world_from_tree` carries S(1 / metres per unit) of the design's [`TreeScale`], taken
+//! when the first tree is planted and changed only by an explicit event (a holding height, a
+//! known length marked; never the camera height's frame-to-frame refinement), which rescales
+//! every tree about its trunk base.
 //!
 //! The design's part is [`DesignScale`]: every shown frame goes to [`DesignScale::observe`]; the
 //! camera-height field sends `InputEvent::HoldingHeight`; choosing the known-length or measure
@@ -37,6 +40,49 @@ pub struct ScaleState {
     heights: CameraHeights,
     /// The scale of a known length the user marked (fixed when marked).
     known: Option<MetricScale>,
+}
+
+/// The scale the design's trees are placed with: `world_from_tree` carries
+/// S(1 / [`TreeScale::metres_per_unit`]) (tree space is metres). It is taken when the first tree
+/// is planted and changes only on an explicit scale event (a holding height entered, a known
+/// length marked) or a restored placement, never with the camera height's frame-to-frame
+/// refinement: a planted tree does not breathe.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum TreeScale {
+    /// Planted before there was a scale: the tracker's unit is taken as a metre, and the first
+    /// scale that comes is adopted.
+    Awaiting,
+    /// The tracker's unit taken as a metre until an explicit scale event (version 2 sessions and
+    /// designs made with `DesignState::new`).
+    TrackerUnit,
+    /// A metric scale, as it was when taken.
+    Metric(MetricScale),
+    /// The scale a restored or recreated tree's placement carried (not the current scale).
+    Restored { metres_per_unit: f64 },
+}
+
+impl TreeScale {
+    /// Metres per unit of the tracker's world that the trees are placed with.
+    pub fn metres_per_unit(&self) -> f64 {
+        match self {
+            TreeScale::Awaiting | TreeScale::TrackerUnit => 1.0,
+            TreeScale::Metric(scale) => scale.metres_per_unit,
+            TreeScale::Restored { metres_per_unit } => *metres_per_unit,
+        }
+    }
+
+    /// The status line's words for the tree.
+    pub fn status(&self) -> String {
+        match self {
+            TreeScale::Awaiting | TreeScale::TrackerUnit => {
+                "Tree at the tracker's unit (no metric scale)".into()
+            }
+            TreeScale::Metric(scale) => format!("Tree at metric scale from {scale}"),
+            TreeScale::Restored { metres_per_unit } => format!(
+                "Tree at its restored placement's scale ({metres_per_unit:.3} m per unit)"
+            ),
+        }
+    }
 }
 
 /// A distance measured with the tool, metres.
@@ -327,30 +373,30 @@ impl DesignScale {
     }
 
     /// A touch while a tool is chosen; a tap (a touch that did not move) is one of the pair.
-    pub fn touch(&mut self, phase: TouchPhase, id: u64, pixel: Vec2) {
+    /// True when it marked a known length (the scale changed).
+    pub fn touch(&mut self, phase: TouchPhase, id: u64, pixel: Vec2) -> bool {
         match phase {
             TouchPhase::Start => {
                 self.touch_starts.insert(id, pixel);
+                false
             }
-            TouchPhase::Move => {}
-            TouchPhase::End => {
-                if let Some(start) = self.touch_starts.remove(&id)
-                    && start.distance(pixel) <= TAP_SLOP_PX
-                {
-                    self.tap(pixel);
-                }
-            }
+            TouchPhase::Move => false,
+            TouchPhase::End => match self.touch_starts.remove(&id) {
+                Some(start) if start.distance(pixel) <= TAP_SLOP_PX => self.tap(pixel),
+                _ => false,
+            },
         }
     }
 
-    /// The first tap waits for the second in the same frame; the second measures or marks.
-    fn tap(&mut self, pixel: Vec2) {
+    /// The first tap waits for the second in the same frame; the second measures or marks (true
+    /// when a known length was marked).
+    fn tap(&mut self, pixel: Vec2) -> bool {
         let Some(tool) = self.tool else {
-            return;
+            return false;
         };
         let Some(pair) = self.taps.tap(self.num_shown, pixel.as_dvec2()) else {
             self.message = Some("First point marked: tap the second in this frame".into());
-            return;
+            return false;
         };
         let pair = PixelPair {
             frame: self.frame_index.unwrap_or(pair.frame),
@@ -358,7 +404,7 @@ impl DesignScale {
         };
         let (Some(camera), Some(shown)) = (self.camera.as_ref(), self.shown.as_ref()) else {
             self.message = Some("No tracked frame to pick in yet".into());
-            return;
+            return false;
         };
         let view = FrameView {
             frame: pair.frame,
@@ -367,6 +413,7 @@ impl DesignScale {
             plane: shown.plane,
             points: &shown.points,
         };
+        let mut marked = false;
         self.message = Some(match tool {
             ScaleTool::Measure => match self.state.measure(&view, &pair) {
                 Ok(measured) => {
@@ -380,11 +427,15 @@ impl DesignScale {
             },
             ScaleTool::KnownLength { length_m } => {
                 match self.state.mark_known_length(&view, &pair, length_m) {
-                    Ok(_) => format!("Known length of {length_m:.2} m marked"),
+                    Ok(_) => {
+                        marked = true;
+                        format!("Known length of {length_m:.2} m marked")
+                    }
                     Err(e) => format!("Known length not taken: {e}"),
                 }
             }
         });
+        marked
     }
 }
 

@@ -27,7 +27,7 @@ use sylva_core::{NodeId, Tree};
 
 use crate::planting::{SceneChoice, growth_scene, tree_scene};
 use crate::render::{GroundPlane, ViewCamera};
-use crate::scale::{DesignScale, ScaleTool};
+use crate::scale::{DesignScale, ScaleTool, TreeScale};
 use crate::scene_tracking::SceneOccupancy;
 
 mod garden;
@@ -330,6 +330,8 @@ pub struct DesignState {
     pub(crate) occupancy: Option<SceneOccupancy>,
     /// The metric scale, its tools and what they measured.
     pub scale: DesignScale,
+    /// The scale every tree of the design is placed with (`world_from_tree` carries it).
+    pub tree_scale: TreeScale,
     pub time_s: f64,
     /// Bumped whenever the tree changes (the renderer re-meshes on change).
     pub revision: u64,
@@ -402,6 +404,7 @@ impl DesignState {
     pub fn new(seed: u64, params: Parameters) -> DesignState {
         DesignState {
             world_from_tree: Some(Affine3A::IDENTITY),
+            tree_scale: TreeScale::TrackerUnit,
             ..DesignState::unplanted(seed, params)
         }
     }
@@ -434,6 +437,7 @@ impl DesignState {
             moving_base: None,
             occupancy: None,
             scale: DesignScale::default(),
+            tree_scale: TreeScale::Awaiting,
             time_s: 0.0,
             revision: 0,
             grow_debt: 0.0,
@@ -530,7 +534,8 @@ impl DesignState {
             }
             InputEvent::Grow { iterations } => self.grow_whole_tree(*iterations),
             InputEvent::HoldingHeight { holding_height_m } => {
-                self.scale.set_holding_height_m(*holding_height_m)
+                self.scale.set_holding_height_m(*holding_height_m);
+                self.adopt_current_scale();
             }
             InputEvent::ScaleTool { tool } => self.scale.choose(*tool),
             InputEvent::Tool { tool } => self.choose_tool(*tool),
@@ -563,13 +568,35 @@ impl DesignState {
         self.tree = tree;
         self.timeline = Timeline::with_budget(TIMELINE_BUDGET_TREES);
         self.timeline.keep(&self.tree);
-        if let Some(m) = world_from_tree {
-            self.world_from_tree = Some(Affine3A::from_cols_array(&m));
+        if let Some(m) = world_from_tree.map(|m| Affine3A::from_cols_array(&m))
+            && let Some(scale) = self.restored_scale(&m)
+        {
+            self.set_tree_scale(scale);
+            self.world_from_tree = Some(m);
         }
         self.brush = None;
         self.bend = None;
         self.selected = None;
         self.changed();
+    }
+
+    /// The design scale a restored placement carries (None for a placement that cannot be one:
+    /// not finite, or no plausible scale): the current scale when it is that one, the design's
+    /// own when unchanged.
+    fn restored_scale(&self, world_from_tree: &Affine3A) -> Option<TreeScale> {
+        let metres_per_unit = f64::from(crate::planting::metres_per_unit_of(world_from_tree));
+        if !(world_from_tree.is_finite() && (1e-3..=1e3).contains(&metres_per_unit)) {
+            return None;
+        }
+        let same = |a: f64| (a / metres_per_unit - 1.0).abs() < 1e-5;
+        let current = self.scale.state.current();
+        Some(if same(self.tree_scale.metres_per_unit()) {
+            self.tree_scale
+        } else if let Some(scale) = current.filter(|s| same(s.metres_per_unit)) {
+            TreeScale::Metric(scale)
+        } else {
+            TreeScale::Restored { metres_per_unit }
+        })
     }
 
     /// New parameters (undoable). Another species starts a seedling of it.
@@ -685,8 +712,11 @@ impl DesignState {
 
     fn touch(&mut self, phase: TouchPhase, id: u64, pixel: Vec2) {
         if self.scale.tool.is_some() {
-            // A scale tool takes the taps (its touches never reach the tree).
-            self.scale.touch(phase, id, pixel);
+            // A scale tool takes the taps (its touches never reach the tree); a known length
+            // marked rescales the design.
+            if self.scale.touch(phase, id, pixel) {
+                self.adopt_current_scale();
+            }
             return;
         }
         if self.recreate_touch(phase, id, pixel) {

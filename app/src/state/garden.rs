@@ -272,7 +272,8 @@ impl DesignState {
         } else {
             self.check_in();
         }
-        let world_from_new = world_from_tree_at(point, &ground);
+        let world_from_new =
+            world_from_tree_at(point, &ground, self.tree_scale.metres_per_unit() as f32);
         let in_garden = self
             .garden
             .garden_from_world
@@ -478,6 +479,63 @@ impl DesignState {
         }
         self.garden.kept.clear();
         self.check_out(self.garden.selected);
+    }
+
+    /// Where the garden's origin (its first tree's trunk base) stands in the world (None for a
+    /// single tree).
+    pub(crate) fn garden_origin_in_world(&self) -> Option<Vec3> {
+        self.garden.stand.as_ref()?;
+        Some(
+            self.garden
+                .garden_from_world
+                .inverse()
+                .transform_point3(Vec3::ZERO),
+        )
+    }
+
+    /// A new design scale moved the world under the garden by `world_from_old` (a uniform scale
+    /// about the garden's origin): every tree's placement follows, in the garden, its undo steps
+    /// and its kept ages, so the garden keeps its layout in metres.
+    pub(crate) fn rescale_garden(&mut self, world_from_old: &Affine3A) {
+        let map = *world_from_old;
+        let garden = &mut self.garden;
+        if garden.stand.is_some() {
+            garden.garden_from_world = garden.garden_from_world * map.inverse();
+        }
+        let place = |stand: &mut Stand| {
+            for m in &mut stand.members {
+                m.world_from_tree = map * m.world_from_tree;
+            }
+        };
+        // Kept stands are shared between the garden and its undo steps: moved once each.
+        let mut moved: Vec<(*const Stand, Arc<Stand>)> = Vec::new();
+        let mut place_kept = |kept: &mut Vec<Arc<Stand>>| {
+            for k in kept.iter_mut() {
+                let key = Arc::as_ptr(k);
+                let new = match moved.iter().find(|(p, _)| *p == key) {
+                    Some((_, new)) => new.clone(),
+                    None => {
+                        let mut stand = (**k).clone();
+                        place(&mut stand);
+                        let new = Arc::new(stand);
+                        moved.push((key, new.clone()));
+                        new
+                    }
+                };
+                *k = new;
+            }
+        };
+        if let Some(stand) = garden.stand.as_mut() {
+            place(stand);
+        }
+        place_kept(&mut garden.kept);
+        for step in &mut garden.undo {
+            if let Some(stand) = step.stand.as_mut() {
+                place(stand);
+            }
+            step.world_from_tree = step.world_from_tree.map(|m| map * m);
+            place_kept(&mut step.kept);
+        }
     }
 
     /// Garden steps undo can take back.

@@ -76,7 +76,7 @@ pub fn status_line_ui(ui: &Ui, design: &DesignState, view: egui::Rect) {
                 .inner_margin(6.0)
                 .show(ui, |ui| {
                     ui.label(
-                        RichText::new(design.scale.state.status())
+                        RichText::new(design.scale_status())
                             .size(15.0)
                             .color(Color32::WHITE),
                     );
