@@ -140,6 +140,8 @@ pub fn recreate(args: RecreateArgs) -> anyhow::Result<()> {
         args.seed,
         args.max_years,
         Some(load),
+        // track_footage has scaled the world to metres.
+        1.0,
     )
     .with_context(|| format!("bad marks in {}", args.marks.display()))?;
     let (tree, world_from_tree) = (&recreated.tree, recreated.world_from_tree);

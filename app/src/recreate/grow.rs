@@ -100,10 +100,21 @@ pub struct Guide<'a> {
     pub coverage: Option<Coverage<'a>>,
 }
 
-/// The tree placed at the trunk base, upright on the ground.
-pub fn world_from_tree(base: DVec3, up: DVec3) -> Affine3A {
+/// The tree (grown in metres) placed at the trunk base, upright on the ground, in a world of
+/// `metres_per_unit` metres per unit: `T(base) * R(up) * S(1 / metres_per_unit)`, as the design
+/// places its trees.
+pub fn world_from_tree(base: DVec3, up: DVec3, metres_per_unit: f64) -> Affine3A {
     let up = up.as_vec3().try_normalize().unwrap_or(Vec3::Y);
-    Affine3A::from_rotation_translation(Quat::from_rotation_arc(Vec3::Y, up), base.as_vec3())
+    let units_per_metre = if metres_per_unit.is_finite() && metres_per_unit > 0.0 {
+        (1.0 / metres_per_unit) as f32
+    } else {
+        1.0
+    };
+    Affine3A::from_scale_rotation_translation(
+        Vec3::splat(units_per_metre),
+        Quat::from_rotation_arc(Vec3::Y, up),
+        base.as_vec3(),
+    )
 }
 
 /// The preset whose proportions (height over spread at 10 years) are closest to the measured ones.
@@ -333,6 +344,10 @@ fn shallowest_near_best(scores: &[f64], tolerance: f64) -> Option<usize> {
 /// in it, while shoots may still cross the hull's gaps between its lobes. `guide.coverage`, when
 /// given, scores a grown tree against the crown's views (its foliage's agreement with them):
 /// growth then goes on while that rises and the best-scoring tree is kept.
+///
+/// The tree grows in metres whatever the world's unit: the hull, the points and the measures
+/// (in the world's units, `metres_per_unit` metres each) are mapped into tree space with the
+/// scale, and the returned `world_from_tree` carries `S(1 / metres_per_unit)`.
 pub fn grow_into_hull(
     species: Species,
     species_choice: String,
@@ -341,12 +356,15 @@ pub fn grow_into_hull(
     guide: Guide,
     up: DVec3,
     max_years: f32,
+    metres_per_unit: f64,
 ) -> (Tree, Affine3A, GrowthReport) {
     let Guide { crown, coverage } = guide;
-    let world_from_tree = world_from_tree(recreation.base, up);
+    let world_from_tree = world_from_tree(recreation.base, up, metres_per_unit);
     let tree_from_world = world_from_tree.inverse();
+    // Metres per world unit as the placement has it (1 where the scale was not usable).
+    let metres = 1.0 / f64::from(world_from_tree.matrix3.x_axis.length());
     let m = &recreation.measurements;
-    let envelope = recreation.hull.eroded(LEAF_REACH_M);
+    let envelope = recreation.hull.eroded(LEAF_REACH_M / metres);
     let envelope = if envelope.num_voxels() > 0 {
         envelope
     } else {
@@ -355,7 +373,7 @@ pub fn grow_into_hull(
     let scene = HullScene {
         hull: &envelope,
         world_from_tree,
-        height_m: m.height_m as f32,
+        height_m: (m.height_m * metres) as f32,
         trunk_column_m: 0.0,
     };
     let mut tree = Tree::new(species, seed);
@@ -363,11 +381,11 @@ pub fn grow_into_hull(
         trunk_column_m: (2.0 * tree.species.internode_length_m).max(0.1),
         ..scene
     };
-    let crown_base_m = m.crown_base_m as f32;
+    let crown_base_m = (m.crown_base_m * metres) as f32;
     // The volume the attraction points fill: the crown's own (shrunk by half the leaves' reach,
     // its lobes are small), else the envelope.
     let target = crown.map(|c| {
-        let shrunk = c.eroded(0.5 * LEAF_REACH_M);
+        let shrunk = c.eroded(0.5 * LEAF_REACH_M / metres);
         if shrunk.num_voxels() * 4 >= c.num_voxels() {
             shrunk
         } else {
@@ -384,7 +402,7 @@ pub fn grow_into_hull(
     // Attraction points: voxel centres of the hull (an even subset, jittered within the voxel),
     // and the tree's own points.
     let stride = hull_in_tree.len().div_ceil(HULL_POINTS).max(1);
-    let voxel_m = envelope.voxel_m as f32;
+    let voxel_m = (envelope.voxel_m * metres) as f32;
     let mut num_points = 0;
     for p in hull_in_tree.iter().step_by(stride) {
         let jitter = Vec3::new(

@@ -81,6 +81,11 @@ impl Recreated {
 /// silhouettes ([`segment`]): growth fills the real crown's lobes, not the outlines' convex
 /// hull. The `sylva recreate` command and the app's Recreate mode both come here. The marks
 /// must already be checked against the footage's size ([`marks::Marks::validate`]).
+///
+/// `metres_per_unit` is the metres in one unit of the footage's world: 1 for
+/// [`footage::track_footage`]'s (already metric), the design's scale for the tracker's world
+/// in the app. The measures stay in the world's units; the tree grows in metres and
+/// `world_from_tree` carries `S(1 / metres_per_unit)`.
 pub fn recreate(
     footage: &footage::TrackedFootage,
     marks: &marks::Marks,
@@ -88,6 +93,7 @@ pub fn recreate(
     seed: u64,
     max_years: f32,
     images: Option<segment::FrameSource>,
+    metres_per_unit: f64,
 ) -> Result<Recreated, marks::MarksError> {
     let mut recreation = measure::measure(footage, marks)?;
     let m = &recreation.measurements;
@@ -148,7 +154,7 @@ pub fn recreate(
     };
     // Growth and the foliage are scored on a few of them (the marked ones first).
     let scored: Vec<&fit::CrownTarget> = fit::spread(&targets, &marked, GROWTH_VIEWS);
-    let placed = grow::world_from_tree(recreation.base, footage.ground.normal);
+    let placed = grow::world_from_tree(recreation.base, footage.ground.normal, metres_per_unit);
     let score = |tree: &sylva_core::Tree| fit::foliage_iou(tree, &placed, footage, &scored);
     let coverage: grow::Coverage = &score;
     let (tree, world_from_tree, mut growth) = grow::grow_into_hull(
@@ -162,11 +168,15 @@ pub fn recreate(
         },
         footage.ground.normal,
         max_years,
+        metres_per_unit,
     );
     let mut tree = tree;
     if let Some(found) = &trunk {
-        let at = (0.5 * recreation.measurements.crown_base_m) as f32;
-        growth.trunk_width_ratio = Some(trunk::fit_trunk_diameter(&mut tree, found.diameter_m, at));
+        // Tree space is in metres: the world's lengths scaled by the placement's.
+        let metres = 1.0 / f64::from(world_from_tree.matrix3.x_axis.length());
+        let at = (0.5 * recreation.measurements.crown_base_m * metres) as f32;
+        let diameter_m = found.diameter_m * metres;
+        growth.trunk_width_ratio = Some(trunk::fit_trunk_diameter(&mut tree, diameter_m, at));
     }
     growth.trunk = trunk;
     growth.segmented_views = crown_masks.len();

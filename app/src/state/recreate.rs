@@ -304,9 +304,16 @@ impl DesignState {
             .validate(footage.world_from_camera.len(), width, height)
             .map_err(|e| e.to_string())?;
         let species = mode.species.as_deref().map(species_named);
-        let recreated =
-            crate::recreate::recreate(&footage, &marks, species, self.seed, MAX_YEARS, None)
-                .map_err(|e| e.to_string())?;
+        let recreated = crate::recreate::recreate(
+            &footage,
+            &marks,
+            species,
+            self.seed,
+            MAX_YEARS,
+            None,
+            self.scale.state.metres_per_unit(),
+        )
+        .map_err(|e| e.to_string())?;
         let world_from_tree = recreated.world_from_tree.to_cols_array();
         self.recreate.result = Some(RecreateResult {
             measurements: recreated.recreation.measurements.clone(),
