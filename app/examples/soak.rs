@@ -195,9 +195,6 @@ fn main() {
             }
             if step % 1000 == 999 {
                 let (undo, timeline) = design.snapshot_bytes();
-                if std::env::var_os("SOAK_TRACE").is_some() {
-                    eprintln!("own {} saved {} tree_bytes {}", design.tree.own_bytes(), design.tree.saved_state_bytes(), now.tree_bytes);
-                }
                 println!(
                     "step {:>6}: {:>6} internodes, {:>5} attraction points, iteration {:>4}; tree {:>6.2} MiB; heap {:>6.2} MiB ({:.2}x; undo {:.2}, timeline {:.2}), resident {:>6.2} MiB ({:.2}x)",
                     step + 1,
@@ -241,6 +238,15 @@ fn main() {
         peak.internodes,
         peak.resident_ratio(),
         mib(peak_resident),
+    );
+    // What the design holds once the allocator has handed its free pages back (as the design
+    // does at most once a second after a change).
+    sylva_app::memory::release_free_memory();
+    let released = resident_anonymous_bytes().saturating_sub(baseline.anonymous);
+    println!(
+        "design_resident_after_release_mib={:.2} resident_ratio_after_release={:.2}",
+        mib(released),
+        released as f64 / end.tree_bytes.max(1) as f64
     );
     // Where the heap is: the live tree (with its growth working memory), the undo steps and
     // the timeline (as they count themselves), and the rest of the design.
@@ -301,12 +307,15 @@ fn design_step(
         // The designer dislikes a third of the strokes.
         60 if cycle % 3 == 2 => design.apply(&InputEvent::Undo),
         90 if design.tree.iteration > OLDEST_YEARS => {
-            let before = (design.tree.iteration, design.tree.skeleton.len());
+            let asked = design.tree.iteration - SCRUB_BACK_YEARS as u32;
             design.apply(&InputEvent::Grow {
                 iterations: -SCRUB_BACK_YEARS,
             });
-            if std::env::var_os("SOAK_TRACE").is_some() {
-                eprintln!("step {step}: scrub {before:?} -> {:?}", (design.tree.iteration, design.tree.skeleton.len()));
+            // Where the timeline had thinned the years asked for, the scrub lands on an
+            // earlier kept one; landing more than a scrub farther back, the designer takes it
+            // back.
+            if design.tree.iteration + (SCRUB_BACK_YEARS as u32) < asked {
+                design.apply(&InputEvent::Undo);
             }
         }
         90 if cycle % 4 == 0 => design.apply(&InputEvent::Grow { iterations: 2 }),
