@@ -427,6 +427,35 @@ mod tests {
     }
 
     #[test]
+    fn thinning_drops_the_big_old_difference_before_the_small_recent_ones() {
+        // A seedling, a big difference (a tree grown autonomously from it, then shed), and a
+        // dozen small brush-guided iterations on a tree of 2 MB.
+        let seedling = sapling(1);
+        let state = |iteration: u32, bytes: usize, tree_bytes: usize| Kept {
+            iteration,
+            held: Held::Whole(seedling.clone()),
+            bytes,
+            tree_bytes,
+            autonomous: false,
+        };
+        let mut states = vec![state(1, 5_000, 5_000), state(18, 1_000_000, 2_000_000)];
+        states.extend((30..42).map(|k| state(k, 1_000, 2_000_000)));
+        states.push(state(42, 2_000_000, 2_000_000));
+        let timeline = Timeline {
+            states,
+            budget_trees: 1.0,
+            latest_own_bytes: 4_000_000,
+        };
+        let keep = timeline.choose_kept(2_100_000);
+        let kept: Vec<u32> = keep.iter().map(|&i| timeline.states[i].iteration).collect();
+        assert!(!kept.contains(&18), "the big difference goes first: {kept:?}");
+        assert!(
+            (30..42).all(|k| kept.contains(&k)),
+            "the recent iterations stay: {kept:?}"
+        );
+    }
+
+    #[test]
     fn an_unbounded_timeline_ungrows_to_every_iteration_exactly_holding_less_than_copies() {
         let mut tree = sapling(2);
         let mut timeline = Timeline::default();
