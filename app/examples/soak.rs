@@ -330,8 +330,9 @@ fn sapling_step(design: &mut DesignState, walk: &Walk, step: usize, stroke: &mut
     let phase_in_stroke = step % 60;
     if phase_in_stroke == 0 {
         let camera = walk.camera(step);
-        let start = tip_pixels(design, &camera)
-            .get((step / 60 * 7919) % tip_pixels(design, &camera).len().max(1))
+        let tips = tip_pixels(design, &camera);
+        let start = tips
+            .get((step / 60 * 7919) % tips.len().max(1))
             .map_or(Vec2::new(320.0, 240.0), |t| t.0);
         let heading = Vec2::new(((step / 60) as f32 * 2.4).sin(), -1.0).normalize();
         *stroke = (0..=40).map(|k| start + heading * k as f32 * 2.0).collect();
@@ -363,13 +364,7 @@ impl Walk {
     /// Framing the design's tree as it is now (its height, or 3 m at least).
     fn new(design: &DesignState) -> Walk {
         let intrinsics = Intrinsics::from_fov(640, 480, 1.0);
-        let height_m = design
-            .tree
-            .skeleton
-            .internodes
-            .iter()
-            .map(|i| i.end.y)
-            .fold(3.0_f32, f32::max);
+        let height_m = tree_height_m(design).max(3.0);
         Walk {
             intrinsics,
             target: Vec3::new(0.0, 0.5 * height_m, 0.0),
@@ -380,10 +375,20 @@ impl Walk {
 
     fn camera(&self, step: usize) -> ViewCamera {
         let angle = step as f32 * 0.002;
-        let eye =
-            self.target + Vec3::new(angle.sin(), 0.1, angle.cos()) * self.distance_m;
+        let eye = self.target + Vec3::new(angle.sin(), 0.1, angle.cos()) * self.distance_m;
         ViewCamera::looking_at(self.intrinsics, eye, self.target)
     }
+}
+
+/// The height of the tree's highest internode end above its base, metres.
+fn tree_height_m(design: &DesignState) -> f32 {
+    design
+        .tree
+        .skeleton
+        .internodes
+        .iter()
+        .map(|i| i.end.y)
+        .fold(0.0_f32, f32::max)
 }
 
 /// Pixels and world positions of the tree's tips (by arena order) that `camera` sees.
@@ -402,13 +407,7 @@ fn tip_pixels(design: &DesignState, camera: &ViewCamera) -> Vec<(Vec2, Vec3)> {
 /// A stroke of [`STROKE_FRAMES`] finger positions from the `n`-th visible tip of the crown's
 /// upper half (cycling) one metre outwards, away from the trunk's axis and up.
 fn outward_stroke(design: &DesignState, camera: &ViewCamera, n: usize) -> Vec<Vec2> {
-    let height_m = design
-        .tree
-        .skeleton
-        .internodes
-        .iter()
-        .map(|i| i.end.y)
-        .fold(0.0_f32, f32::max);
+    let height_m = tree_height_m(design);
     let tips: Vec<(Vec2, Vec3)> = tip_pixels(design, camera)
         .into_iter()
         .filter(|(_, w)| w.y > 0.5 * height_m)
@@ -416,8 +415,8 @@ fn outward_stroke(design: &DesignState, camera: &ViewCamera, n: usize) -> Vec<Ve
     let Some(&(_, tip)) = tips.get((n * 7919) % tips.len().max(1)) else {
         return Vec::new();
     };
-    let outwards = (Vec3::new(tip.x, 0.0, tip.z).normalize_or_zero() + Vec3::Y * 0.5)
-        .normalize_or(Vec3::Y);
+    let outwards =
+        (Vec3::new(tip.x, 0.0, tip.z).normalize_or_zero() + Vec3::Y * 0.5).normalize_or(Vec3::Y);
     (0..STROKE_FRAMES)
         .filter_map(|k| {
             let t = k as f32 / (STROKE_FRAMES - 1) as f32;

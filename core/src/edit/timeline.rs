@@ -448,7 +448,10 @@ mod tests {
         };
         let keep = timeline.choose_kept(2_100_000);
         let kept: Vec<u32> = keep.iter().map(|&i| timeline.states[i].iteration).collect();
-        assert!(!kept.contains(&18), "the big difference goes first: {kept:?}");
+        assert!(
+            !kept.contains(&18),
+            "the big difference goes first: {kept:?}"
+        );
         assert!(
             (30..42).all(|k| kept.contains(&k)),
             "the recent iterations stay: {kept:?}"
