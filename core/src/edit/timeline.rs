@@ -41,9 +41,21 @@ struct Kept {
     held: Held,
     /// Bytes `held` holds.
     bytes: usize,
+    /// Saved-state bytes of this state ([`Tree::saved_state_bytes`]): a difference back to it
+    /// holds at most about as much (its internodes and points, whole).
+    tree_bytes: usize,
     /// Every iteration since the previous kept state was autonomous growth (so it regrows
     /// from that state exactly, given the same scene).
     autonomous: bool,
+}
+
+/// A kept state as [`Timeline::choose_kept`] weighs it.
+struct Candidate {
+    index: usize,
+    iteration: u32,
+    /// Estimated bytes of its difference.
+    bytes: usize,
+    tree_bytes: usize,
 }
 
 /// Growth states by iteration, for ungrow/regrow.
@@ -114,6 +126,7 @@ impl Timeline {
         self.states.push(Kept {
             iteration: k,
             bytes: compact.saved_state_bytes(),
+            tree_bytes: compact.saved_state_bytes(),
             held: Held::Whole(compact),
             autonomous,
         });
@@ -180,40 +193,54 @@ impl Timeline {
     }
 
     /// Which states stay (by index) when thinning to `target` bytes: greedily drops the
-    /// interior state whose removal leaves the smallest gap relative to its age, estimating
-    /// that the difference across the gap holds as much as the larger of the two it replaces
-    /// (growth changes the same diameters again).
+    /// interior state that loses the least time resolution per byte it saves. The resolution
+    /// lost is the gap its removal leaves relative to its age (old iterations may lie farther
+    /// apart than recent ones); the bytes saved are estimated from the difference across the
+    /// gap, which holds as much as the larger of the two it replaces (growth changes the same
+    /// diameters again) but no more than the earlier state itself (a difference back to a
+    /// small tree is small, however large the one after it).
     fn choose_kept(&self, target: usize) -> Vec<usize> {
         let Some(latest) = self.states.last() else {
             return Vec::new();
         };
         let latest_iteration = latest.iteration;
-        // (index, iteration, estimated bytes) of the states left.
-        let mut left: Vec<(usize, u32, usize)> = self
+        let mut left: Vec<Candidate> = self
             .states
             .iter()
             .enumerate()
-            .map(|(i, s)| (i, s.iteration, s.bytes))
+            .map(|(index, s)| Candidate {
+                index,
+                iteration: s.iteration,
+                bytes: s.bytes,
+                tree_bytes: s.tree_bytes,
+            })
             .collect();
-        let mut total: usize = left.iter().map(|l| l.2).sum();
+        let mut total: usize = left.iter().map(|l| l.bytes).sum();
         let mut removed_any = false;
         while (total > target || !removed_any) && left.len() > 2 {
+            let merged = |i: usize| {
+                left[i - 1]
+                    .bytes
+                    .max(left[i].bytes)
+                    .min(left[i - 1].tree_bytes.max(left[i - 1].bytes))
+            };
             let cost = |i: usize| {
-                let gap = left[i + 1].1 - left[i - 1].1;
-                let age = latest_iteration - left[i].1 + 1;
-                f64::from(gap) / f64::from(age)
+                let gap = left[i + 1].iteration - left[i - 1].iteration;
+                let age = latest_iteration - left[i].iteration + 1;
+                let saved = (left[i - 1].bytes + left[i].bytes).saturating_sub(merged(i));
+                f64::from(gap) / f64::from(age) / saved.max(1) as f64
             };
             let victim = (1..left.len() - 1)
                 .min_by(|&a, &b| cost(a).total_cmp(&cost(b)))
                 .unwrap_or(1);
-            let (_, _, bytes) = left.remove(victim);
+            let merged = merged(victim);
+            let dropped = left.remove(victim);
             // The state before the victim now differs from the one after it.
-            let merged = left[victim - 1].2.max(bytes);
-            total = total - bytes - left[victim - 1].2 + merged;
-            left[victim - 1].2 = merged;
+            total = total - dropped.bytes - left[victim - 1].bytes + merged;
+            left[victim - 1].bytes = merged;
             removed_any = true;
         }
-        left.into_iter().map(|l| l.0).collect()
+        left.into_iter().map(|l| l.index).collect()
     }
 
     /// Keeps only the states at `keep` (increasing indices, the first and the last included),
@@ -264,6 +291,7 @@ impl Timeline {
                 rebuilt.push(Kept {
                     iteration: kept.iteration,
                     bytes: diff.bytes(),
+                    tree_bytes: kept.tree_bytes,
                     held: Held::Back(diff),
                     autonomous: autonomous[index],
                 });
@@ -396,6 +424,38 @@ mod tests {
             );
         }
         saved
+    }
+
+    #[test]
+    fn thinning_drops_the_big_old_difference_before_the_small_recent_ones() {
+        // A seedling, a big difference (a tree grown autonomously from it, then shed), and a
+        // dozen small brush-guided iterations on a tree of 2 MB.
+        let seedling = sapling(1);
+        let state = |iteration: u32, bytes: usize, tree_bytes: usize| Kept {
+            iteration,
+            held: Held::Whole(seedling.clone()),
+            bytes,
+            tree_bytes,
+            autonomous: false,
+        };
+        let mut states = vec![state(1, 5_000, 5_000), state(18, 1_000_000, 2_000_000)];
+        states.extend((30..42).map(|k| state(k, 1_000, 2_000_000)));
+        states.push(state(42, 2_000_000, 2_000_000));
+        let timeline = Timeline {
+            states,
+            budget_trees: 1.0,
+            latest_own_bytes: 4_000_000,
+        };
+        let keep = timeline.choose_kept(2_100_000);
+        let kept: Vec<u32> = keep.iter().map(|&i| timeline.states[i].iteration).collect();
+        assert!(
+            !kept.contains(&18),
+            "the big difference goes first: {kept:?}"
+        );
+        assert!(
+            (30..42).all(|k| kept.contains(&k)),
+            "the recent iterations stay: {kept:?}"
+        );
     }
 
     #[test]
