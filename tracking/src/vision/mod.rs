@@ -1,17 +1,19 @@
 //! The tracker's pure-Rust vision backend: what [`crate::cv`] offers the tracker, written here
 //! so that phones (no OpenCV) run the same tracker. Shi–Tomasi corners ([`corners`]), the
-//! essential matrix and pose recovery, homography RANSAC ([`epipolar`]), PnP RANSAC ([`pnp`]),
+//! essential matrix (Nistér's five-point solver, [`five_point`]) and pose recovery, homography
+//! RANSAC ([`epipolar`]), PnP RANSAC ([`pnp`]),
 //! ORB descriptors and Hamming matching ([`orb`]). Lucas–Kanade is [`crate::lk`]. Every RANSAC
 //! draws from a fixed-seed generator ([`SplitMix64`]), so a run replays identically.
 
 pub mod corners;
 pub mod epipolar;
+pub mod five_point;
 pub mod orb;
 pub mod orb_pattern;
 pub mod pnp;
 
 pub use corners::detect_corners;
-pub use epipolar::{homography_inliers, relative_pose};
+pub use epipolar::{homography_inliers, relative_pose, relative_pose_with};
 pub use orb::{Descriptor, NearestTwo, Orb, hamming};
 pub use pnp::pnp_ransac;
 
@@ -24,6 +26,26 @@ pub enum PnpMinimal {
     /// Algebraic P3P on four points (three and one to choose among the solutions): several
     /// times cheaper than EPnP's SVD, for the thousand hypotheses of relocalisation.
     Ap3p,
+}
+
+/// The minimal solver the essential matrix's RANSAC runs on each sample.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum EssentialMinimal {
+    /// Hartley's normalised eight-point algorithm: one model per sample of eight.
+    #[default]
+    EightPoint,
+    /// Nistér's five-point solver ([`five_point`]): up to ten models per sample of five, the
+    /// minimal case (OpenCV's `findEssentialMat`), exact for planar scenes too.
+    FivePoint,
+}
+
+impl EssentialMinimal {
+    pub fn sample_size(self) -> usize {
+        match self {
+            Self::EightPoint => 8,
+            Self::FivePoint => 5,
+        }
+    }
 }
 
 /// SplitMix64 (Steele, Lea and Flood 2014): a small, fast generator for RANSAC samples.
