@@ -5,8 +5,8 @@
 //! portable backend runs with each of its essential-matrix solvers.
 
 use sylva_tracking::VisionBackend;
-use sylva_tracking::vision::EssentialMinimal;
 use sylva_tracking::report::run_sequence_from;
+use sylva_tracking::vision::EssentialMinimal;
 
 fn main() {
     let mut args = std::env::args().skip(1);
@@ -39,12 +39,17 @@ fn main() {
         .iter()
         .flat_map(|&backend| match backend {
             VisionBackend::Portable => {
-                vec![(backend, EssentialMinimal::EightPoint), (backend, EssentialMinimal::FivePoint)]
+                vec![
+                    (backend, EssentialMinimal::EightPoint),
+                    (backend, EssentialMinimal::FivePoint),
+                ]
             }
             VisionBackend::OpenCv => vec![(backend, EssentialMinimal::FivePoint)],
         })
         .collect();
-    println!("backend   essential   start  tracked  ate_m   window_m  spread  rot_deg  ms_per_frame");
+    println!(
+        "backend   essential   start  tracked  ate_m   window_m  spread  rot_deg  ms_per_frame"
+    );
     for &(backend, essential_minimal) in &runs {
         for &first in &starts {
             let config = sylva_tracking::TrackerConfig {

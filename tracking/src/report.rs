@@ -105,11 +105,7 @@ pub fn run_sequence(
     progress: impl FnMut(usize, usize),
     on_skip: impl FnMut(&SkippedFrame),
 ) -> Result<TrackReport, RunError> {
-    let options = ScaleOptions {
-        holding_height_m: config.holding_height_m,
-        ..ScaleOptions::default()
-    };
-    run_sequence_scaled(root, config, &options, progress, on_skip)
+    run_sequence_from(root, config, 0, progress, on_skip)
 }
 
 /// [`run_sequence`] with the scale's inputs (holding height, a known length) and measurements

@@ -5,10 +5,8 @@
 //! points in front of both cameras (cheirality). The homography by Hartley's normalised
 //! four-point DLT inside RANSAC on the transfer error, refitted on its inliers.
 
-use super::five_point::essentials_from_five;
-use super::{
-    EssentialMinimal, SplitMix64, least_squares_null_9, null_vector_9, ransac_iterations,
-};
+use super::five_point::{epipolar_row, essentials_from_five};
+use super::{EssentialMinimal, SplitMix64, least_squares_null_9, null_vector_9, ransac_iterations};
 use crate::camera::Camera;
 use crate::pose::Se3;
 use glam::{DMat3, DQuat, DVec2, DVec3};
@@ -125,20 +123,7 @@ fn sampson_sq(e: &DMat3, x1: DVec2, x2: DVec2) -> f64 {
 fn epipolar_rows(p1: &[DVec2], p2: &[DVec2], indices: &[usize]) -> Vec<[f64; 9]> {
     indices
         .iter()
-        .map(|&i| {
-            let (a, b) = (p1[i], p2[i]);
-            [
-                b.x * a.x,
-                b.x * a.y,
-                b.x,
-                b.y * a.x,
-                b.y * a.y,
-                b.y,
-                a.x,
-                a.y,
-                1.0,
-            ]
-        })
+        .map(|&i| epipolar_row(p1[i], p2[i]))
         .collect()
 }
 
@@ -307,7 +292,13 @@ pub fn relative_pose(
     second: &[DVec2],
     threshold_px: f64,
 ) -> Option<(Se3, Vec<bool>)> {
-    relative_pose_with(camera, first, second, threshold_px, EssentialMinimal::default())
+    relative_pose_with(
+        camera,
+        first,
+        second,
+        threshold_px,
+        EssentialMinimal::default(),
+    )
 }
 
 /// [`relative_pose`] with the essential matrix's minimal solver chosen.
@@ -444,7 +435,7 @@ pub fn homography_inliers(
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
 
     fn camera() -> Camera {
@@ -452,7 +443,7 @@ mod tests {
     }
 
     /// Random points in front of both cameras, their normalised coordinates in each.
-    fn scene(motion: &Se3, n: usize, seed: u64) -> (Vec<DVec2>, Vec<DVec2>) {
+    pub(crate) fn scene(motion: &Se3, n: usize, seed: u64) -> (Vec<DVec2>, Vec<DVec2>) {
         let mut rng = SplitMix64::new(seed);
         let (mut a, mut b) = (Vec::new(), Vec::new());
         while a.len() < n {
@@ -506,24 +497,24 @@ mod tests {
                 *p += DVec2::new(rng.unit() - 0.5, rng.unit() - 0.5) * 0.2;
             }
             for minimal in [EssentialMinimal::EightPoint, EssentialMinimal::FivePoint] {
-            let (pose, mask) =
-                relative_pose_with(&camera(), &a, &b, 1.0, minimal).expect("pose");
-            let t = motion.translation.normalize();
-            // Wrong matches that happen to lie near their epipolar line count as inliers: a
-            // model slightly off that takes them in has the lower MSAC cost, and they pull the
-            // refit a little: a thousandth or two of a radian.
-            let angle = pose.rotation.angle_between(motion.rotation);
-            let shift = (pose.translation - t).length();
-            assert!(
-                angle < 2e-3 && shift < 2e-2,
-                "seed {seed}, {minimal:?}: {angle} rad, {shift}"
-            );
-            let inliers = mask.iter().filter(|&&m| m).count();
-            assert!(
-                mask[50..].iter().all(|&m| m),
-                "seed {seed}: clean points are inliers"
-            );
-            assert!(inliers <= 160, "seed {seed}: {inliers} inliers");
+                let (pose, mask) =
+                    relative_pose_with(&camera(), &a, &b, 1.0, minimal).expect("pose");
+                let t = motion.translation.normalize();
+                // Wrong matches that happen to lie near their epipolar line count as inliers: a
+                // model slightly off that takes them in has the lower MSAC cost, and they pull the
+                // refit a little: a thousandth or two of a radian.
+                let angle = pose.rotation.angle_between(motion.rotation);
+                let shift = (pose.translation - t).length();
+                assert!(
+                    angle < 2e-3 && shift < 2e-2,
+                    "seed {seed}, {minimal:?}: {angle} rad, {shift}"
+                );
+                let inliers = mask.iter().filter(|&&m| m).count();
+                assert!(
+                    mask[50..].iter().all(|&m| m),
+                    "seed {seed}: clean points are inliers"
+                );
+                assert!(inliers <= 160, "seed {seed}: {inliers} inliers");
             }
         }
     }
@@ -557,8 +548,8 @@ mod tests {
             for p in b.iter_mut().step_by(5) {
                 *p += DVec2::new(wrong.unit() - 0.5, wrong.unit() - 0.5) * 0.3;
             }
-            let (pose, _) = relative_pose_with(&cam, &a, &b, 1.0, EssentialMinimal::FivePoint)
-                .expect("pose");
+            let (pose, _) =
+                relative_pose_with(&cam, &a, &b, 1.0, EssentialMinimal::FivePoint).expect("pose");
             let angle = pose.rotation.angle_between(motion.rotation);
             let direction = pose.translation.angle_between(motion.translation);
             // A sideways step with a turn about the vertical is the ambiguous case of two-view

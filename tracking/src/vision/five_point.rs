@@ -108,7 +108,7 @@ fn scale(a: &Poly, s: f64) -> Poly {
 }
 
 /// Row-major epipolar row of `x2ᵀ E x1 = 0`.
-fn epipolar_row(a: DVec2, b: DVec2) -> [f64; 9] {
+pub(crate) fn epipolar_row(a: DVec2, b: DVec2) -> [f64; 9] {
     [
         b.x * a.x,
         b.x * a.y,
@@ -123,61 +123,18 @@ fn epipolar_row(a: DVec2, b: DVec2) -> [f64; 9] {
 }
 
 /// An orthonormal basis of the null space of five rows of nine (rank five): Gauss–Jordan with
-/// full pivoting, one null vector per free column, then Gram–Schmidt. None when the rows are
-/// of lower rank (a degenerate sample).
+/// full pivoting ([`super::null_space_9`]), then Gram–Schmidt. None when the rows are of lower
+/// rank (a degenerate sample).
 fn null_space_5x9(rows: &[[f64; 9]; 5]) -> Option<[[f64; 9]; 4]> {
-    let mut m = *rows;
-    let scale = m
-        .iter()
-        .flat_map(|r| r.iter())
-        .fold(0.0f64, |s, v| s.max(v.abs()));
-    if scale == 0.0 {
-        return None;
-    }
-    let mut pivot_cols = [0usize; 5];
-    let mut used = [false; 9];
-    for step in 0..5 {
-        let (mut best, mut br, mut bc) = (0.0, 0, 0);
-        for (r, row) in m.iter().enumerate().skip(step) {
-            for c in (0..9).filter(|&c| !used[c]) {
-                if row[c].abs() > best {
-                    (best, br, bc) = (row[c].abs(), r, c);
-                }
-            }
-        }
-        if best <= 1e-10 * scale {
-            return None;
-        }
-        m.swap(step, br);
-        used[bc] = true;
-        pivot_cols[step] = bc;
-        let p = m[step][bc];
-        for v in m[step].iter_mut() {
-            *v /= p;
-        }
-        let pivot_row = m[step];
-        for (r, row) in m.iter_mut().enumerate() {
-            if r != step && row[bc] != 0.0 {
-                let f = row[bc];
-                for c in 0..9 {
-                    row[c] -= f * pivot_row[c];
-                }
-            }
-        }
-    }
-    let mut basis = [[0.0; 9]; 4];
-    for (vector, free) in basis.iter_mut().zip((0..9).filter(|&c| !used[c])) {
-        vector[free] = 1.0;
-        for (step, &c) in pivot_cols.iter().enumerate() {
-            vector[c] = -m[step][free];
-        }
-    }
+    let null = super::null_space_9(rows, 5, 1e-10)?;
+    let mut basis: [[f64; 9]; 4] = null.try_into().ok()?;
     // Gram–Schmidt: the basis's conditioning carries into the cubic constraints.
     for k in 0..4 {
         for j in 0..k {
-            let d: f64 = (0..9).map(|c| basis[k][c] * basis[j][c]).sum();
-            for c in 0..9 {
-                basis[k][c] -= d * basis[j][c];
+            let done = basis[j];
+            let d: f64 = basis[k].iter().zip(&done).map(|(a, b)| a * b).sum();
+            for (v, b) in basis[k].iter_mut().zip(&done) {
+                *v -= d * b;
             }
         }
         let norm = basis[k].iter().map(|v| v * v).sum::<f64>().sqrt();
@@ -215,9 +172,7 @@ fn constraint_rows(basis: &[[f64; 9]; 4]) -> [Poly; 10] {
     );
     // E Eᵀ: quadratic entries.
     let eet: [[Poly; 3]; 3] = std::array::from_fn(|r| {
-        std::array::from_fn(|c| {
-            (0..3).fold([0.0; 20], |s, k| add(&s, &mul(&e[r][k], &e[c][k])))
-        })
+        std::array::from_fn(|c| (0..3).fold([0.0; 20], |s, k| add(&s, &mul(&e[r][k], &e[c][k]))))
     });
     let half_trace = scale(&add(&add(&eet[0][0], &eet[1][1]), &eet[2][2]), 0.5);
     let mut rows = [[0.0; 20]; 10];
@@ -314,7 +269,10 @@ pub(crate) fn real_roots(p: &[f64]) -> Vec<f64> {
         _ => {}
     }
     let lead = p[degree];
-    let bound = 1.0 + p[..degree].iter().fold(0.0f64, |s, v| s.max((v / lead).abs()));
+    let bound = 1.0
+        + p[..degree]
+            .iter()
+            .fold(0.0f64, |s, v| s.max((v / lead).abs()));
     let derivative: Vec<f64> = (1..=degree).map(|k| k as f64 * p[k]).collect();
     let mut ends = vec![-bound];
     let mut critical = real_roots(&derivative);
@@ -413,8 +371,9 @@ pub fn essentials_from_five(first: &[DVec2; 5], second: &[DVec2; 5]) -> Vec<DMat
             continue;
         };
         let (x, y) = (v.x / v.z, v.y / v.z);
-        let e: [f64; 9] =
-            std::array::from_fn(|k| x * basis[0][k] + y * basis[1][k] + z * basis[2][k] + basis[3][k]);
+        let e: [f64; 9] = std::array::from_fn(|k| {
+            x * basis[0][k] + y * basis[1][k] + z * basis[2][k] + basis[3][k]
+        });
         let norm = e.iter().map(|v| v * v).sum::<f64>().sqrt();
         if !(norm.is_finite() && norm > 0.0) {
             continue;
@@ -445,24 +404,10 @@ mod tests {
         )
     }
 
-    fn five_pairs(motion: &Se3, rng: &mut SplitMix64) -> ([DVec2; 5], [DVec2; 5]) {
-        let (mut a, mut b) = ([DVec2::ZERO; 5], [DVec2::ZERO; 5]);
-        let mut k = 0;
-        while k < 5 {
-            let p = DVec3::new(
-                4.0 * rng.unit() - 2.0,
-                3.0 * rng.unit() - 1.5,
-                2.0 + 6.0 * rng.unit(),
-            );
-            let q = motion.transform_point(p);
-            if q.z < 0.5 {
-                continue;
-            }
-            a[k] = p.truncate() / p.z;
-            b[k] = q.truncate() / q.z;
-            k += 1;
-        }
-        (a, b)
+    /// Five pairs of a random scene (the epipolar tests' points in front of both cameras).
+    fn five_pairs(motion: &Se3, seed: u64) -> ([DVec2; 5], [DVec2; 5]) {
+        let (a, b) = crate::vision::epipolar::tests::scene(motion, 5, seed);
+        (std::array::from_fn(|i| a[i]), std::array::from_fn(|i| b[i]))
     }
 
     #[test]
@@ -495,9 +440,15 @@ mod tests {
                 ),
                 DVec3::new(rng.unit() - 0.5, rng.unit() - 0.5, rng.unit() - 0.5),
             );
-            let (a, b) = five_pairs(&motion, &mut rng);
+            let (a, b) = five_pairs(&motion, 1000 + trial);
             let truth = skew(motion.translation) * DMat3::from_quat(motion.rotation);
-            let truth = truth / truth.to_cols_array().iter().map(|v| v * v).sum::<f64>().sqrt();
+            let truth = truth
+                / truth
+                    .to_cols_array()
+                    .iter()
+                    .map(|v| v * v)
+                    .sum::<f64>()
+                    .sqrt();
             let solutions = essentials_from_five(&a, &b);
             assert!(
                 !solutions.is_empty() && solutions.len() <= 10,
@@ -507,9 +458,15 @@ mod tests {
             let distance = |e: &DMat3| {
                 let d = (*e - truth).to_cols_array();
                 let s = (*e + truth).to_cols_array();
-                d.iter().map(|v| v * v).sum::<f64>().min(s.iter().map(|v| v * v).sum()).sqrt()
+                d.iter()
+                    .map(|v| v * v)
+                    .sum::<f64>()
+                    .min(s.iter().map(|v| v * v).sum())
+                    .sqrt()
             };
-            let Some(nearest) = solutions.iter().min_by(|p, q| distance(p).total_cmp(&distance(q)))
+            let Some(nearest) = solutions
+                .iter()
+                .min_by(|p, q| distance(p).total_cmp(&distance(q)))
             else {
                 continue;
             };
@@ -518,7 +475,11 @@ mod tests {
                 let r = q.extend(1.0).dot(*nearest * p.extend(1.0));
                 assert!(r.abs() < 1e-6, "trial {trial}: residual {r}");
             }
-            assert!(nearest.determinant().abs() < 1e-6, "trial {trial}: det {}", nearest.determinant());
+            assert!(
+                nearest.determinant().abs() < 1e-6,
+                "trial {trial}: det {}",
+                nearest.determinant()
+            );
             errors.push(distance(nearest));
         }
         // Minimal solvers lose digits on ill-conditioned samples: most are exact to rounding, a

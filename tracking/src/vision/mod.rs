@@ -108,15 +108,24 @@ pub(crate) fn ransac_iterations(confidence: f64, inlier_ratio: f64, k: usize, ma
 /// A null vector of the `rows × 9` matrix `a` (row-major) of rank 8: Gauss–Jordan elimination
 /// with full pivoting, the free column set to 1. None when the rank is below 8.
 pub(crate) fn null_vector_9(a: &[[f64; 9]]) -> Option<[f64; 9]> {
+    let x = null_space_9(a, 8, 1e-12)?.pop()?;
+    let norm = x.iter().map(|v| v * v).sum::<f64>().sqrt();
+    Some(x.map(|v| v / norm))
+}
+
+/// The `9 − rank` null vectors of the `rows × 9` matrix `a` of rank `rank` by Gauss–Jordan
+/// elimination with full pivoting, one per free column (set to 1, the others 0; not
+/// normalised). None when a pivot falls below `tolerance` times the largest entry.
+pub(crate) fn null_space_9(a: &[[f64; 9]], rank: usize, tolerance: f64) -> Option<Vec<[f64; 9]>> {
     let mut m: Vec<[f64; 9]> = a.to_vec();
     let rows = m.len();
-    let mut pivot_cols = [usize::MAX; 8];
+    let mut pivot_cols = vec![usize::MAX; rank];
     let mut used = [false; 9];
     let scale = m
         .iter()
         .flat_map(|r| r.iter())
         .fold(0.0f64, |s, v| s.max(v.abs()));
-    if scale == 0.0 || rows < 8 {
+    if scale == 0.0 || rows < rank || rank > 8 {
         return None;
     }
     for (step, pivot_col) in pivot_cols.iter_mut().enumerate() {
@@ -129,7 +138,7 @@ pub(crate) fn null_vector_9(a: &[[f64; 9]]) -> Option<[f64; 9]> {
                 }
             }
         }
-        if best <= 1e-12 * scale {
+        if best <= tolerance * scale {
             return None;
         }
         m.swap(step, br);
@@ -149,14 +158,18 @@ pub(crate) fn null_vector_9(a: &[[f64; 9]]) -> Option<[f64; 9]> {
             }
         }
     }
-    let free = (0..9).find(|&c| !used[c])?;
-    let mut x = [0.0; 9];
-    x[free] = 1.0;
-    for (step, &c) in pivot_cols.iter().enumerate() {
-        x[c] = -m[step][free];
-    }
-    let norm = x.iter().map(|v| v * v).sum::<f64>().sqrt();
-    Some(x.map(|v| v / norm))
+    let null = (0..9)
+        .filter(|&c| !used[c])
+        .map(|free| {
+            let mut x = [0.0; 9];
+            x[free] = 1.0;
+            for (step, &c) in pivot_cols.iter().enumerate() {
+                x[c] = -m[step][free];
+            }
+            x
+        })
+        .collect();
+    Some(null)
 }
 
 /// The unit vector minimising `|A x|` for `A` given by its rows (least squares over more than
