@@ -117,11 +117,18 @@ impl Vision {
         first: &[DVec2],
         second: &[DVec2],
         threshold_px: f64,
+        minimal: vision::EssentialMinimal,
     ) -> Result<Option<(Se3, Vec<bool>)>, TrackerError> {
         match self {
             #[cfg(feature = "opencv")]
             Self::OpenCv(_) => Ok(cv::relative_pose(camera, first, second, threshold_px)?),
-            Self::Portable(_) => Ok(vision::relative_pose(camera, first, second, threshold_px)),
+            Self::Portable(_) => Ok(vision::relative_pose_with(
+                camera,
+                first,
+                second,
+                threshold_px,
+                minimal,
+            )),
         }
     }
 

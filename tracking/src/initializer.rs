@@ -128,9 +128,13 @@ impl Tracker {
         }
         let first: Vec<DVec2> = pairs.iter().map(|p| p.1).collect();
         let second: Vec<DVec2> = pairs.iter().map(|p| p.2).collect();
-        let Some((relative, inliers)) =
-            self.vision
-                .relative_pose(&self.camera, &first, &second, 1.0)?
+        let Some((relative, inliers)) = self.vision.relative_pose(
+            &self.camera,
+            &first,
+            &second,
+            1.0,
+            self.config.essential_minimal,
+        )?
         else {
             return Ok(None);
         };

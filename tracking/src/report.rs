@@ -105,17 +105,46 @@ pub fn run_sequence(
     progress: impl FnMut(usize, usize),
     on_skip: impl FnMut(&SkippedFrame),
 ) -> Result<TrackReport, RunError> {
-    let options = ScaleOptions {
-        holding_height_m: config.holding_height_m,
-        ..ScaleOptions::default()
-    };
-    run_sequence_scaled(root, config, &options, progress, on_skip)
+    run_sequence_from(root, config, 0, progress, on_skip)
 }
 
 /// [`run_sequence`] with the scale's inputs (holding height, a known length) and measurements
 /// (`sylva track`'s entry). Picks in frames the footage lacks are refused before tracking.
 pub fn run_sequence_scaled(
     root: &Path,
+    config: TrackerConfig,
+    options: &ScaleOptions,
+    progress: impl FnMut(usize, usize),
+    on_skip: impl FnMut(&SkippedFrame),
+) -> Result<TrackReport, RunError> {
+    let sequence = TumSequence::open(root)?;
+    run_opened(root, sequence, config, options, progress, on_skip)
+}
+
+/// [`run_sequence`] from the sequence's frame `first_frame` on (the frames before it dropped,
+/// as if the footage began there): how the tracker's start depends on where the footage starts.
+/// `first_frame` past the end is [`RunError::NoFrameRead`].
+pub fn run_sequence_from(
+    root: &Path,
+    config: TrackerConfig,
+    first_frame: usize,
+    progress: impl FnMut(usize, usize),
+    on_skip: impl FnMut(&SkippedFrame),
+) -> Result<TrackReport, RunError> {
+    let options = ScaleOptions {
+        holding_height_m: config.holding_height_m,
+        ..ScaleOptions::default()
+    };
+    let mut sequence = TumSequence::open(root)?;
+    sequence
+        .frames
+        .drain(..first_frame.min(sequence.frames.len()));
+    run_opened(root, sequence, config, &options, progress, on_skip)
+}
+
+fn run_opened(
+    root: &Path,
+    sequence: TumSequence,
     mut config: TrackerConfig,
     options: &ScaleOptions,
     mut progress: impl FnMut(usize, usize),
@@ -123,7 +152,6 @@ pub fn run_sequence_scaled(
 ) -> Result<TrackReport, RunError> {
     config.holding_height_m = crate::scale::validate_holding_height_m(options.holding_height_m)
         .map_err(RunScaleError::from)?;
-    let sequence = TumSequence::open(root)?;
     let num_frames = sequence.frames.len();
     let check = |frame: usize| {
         (frame < num_frames)

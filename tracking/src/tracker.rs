@@ -86,6 +86,9 @@ pub struct TrackerConfig {
     /// Corners, two-view geometry, PnP and ORB: OpenCV or the portable backend. Default
     /// OpenCV where the build has it, else portable.
     pub backend: VisionBackend,
+    /// The portable backend's minimal essential-matrix solver for the two-view start (OpenCV's
+    /// is always five-point). Default eight-point: see the README's start-frame table.
+    pub essential_minimal: crate::vision::EssentialMinimal,
 }
 
 impl Default for TrackerConfig {
@@ -113,6 +116,7 @@ impl Default for TrackerConfig {
             lost_after_frames: 30,
             holding_height_m: crate::scale::DEFAULT_HOLDING_HEIGHT_M,
             backend: VisionBackend::default(),
+            essential_minimal: crate::vision::EssentialMinimal::default(),
         }
     }
 }

@@ -1,17 +1,19 @@
 //! The tracker's pure-Rust vision backend: what [`crate::cv`] offers the tracker, written here
 //! so that phones (no OpenCV) run the same tracker. Shi–Tomasi corners ([`corners`]), the
-//! essential matrix and pose recovery, homography RANSAC ([`epipolar`]), PnP RANSAC ([`pnp`]),
+//! essential matrix (Nistér's five-point solver, [`five_point`]) and pose recovery, homography
+//! RANSAC ([`epipolar`]), PnP RANSAC ([`pnp`]),
 //! ORB descriptors and Hamming matching ([`orb`]). Lucas–Kanade is [`crate::lk`]. Every RANSAC
 //! draws from a fixed-seed generator ([`SplitMix64`]), so a run replays identically.
 
 pub mod corners;
 pub mod epipolar;
+pub mod five_point;
 pub mod orb;
 pub mod orb_pattern;
 pub mod pnp;
 
 pub use corners::detect_corners;
-pub use epipolar::{homography_inliers, relative_pose};
+pub use epipolar::{homography_inliers, relative_pose, relative_pose_with};
 pub use orb::{Descriptor, NearestTwo, Orb, hamming};
 pub use pnp::pnp_ransac;
 
@@ -24,6 +26,26 @@ pub enum PnpMinimal {
     /// Algebraic P3P on four points (three and one to choose among the solutions): several
     /// times cheaper than EPnP's SVD, for the thousand hypotheses of relocalisation.
     Ap3p,
+}
+
+/// The minimal solver the essential matrix's RANSAC runs on each sample.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub enum EssentialMinimal {
+    /// Hartley's normalised eight-point algorithm: one model per sample of eight.
+    #[default]
+    EightPoint,
+    /// Nistér's five-point solver ([`five_point`]): up to ten models per sample of five, the
+    /// minimal case (OpenCV's `findEssentialMat`), exact for planar scenes too.
+    FivePoint,
+}
+
+impl EssentialMinimal {
+    pub fn sample_size(self) -> usize {
+        match self {
+            Self::EightPoint => 8,
+            Self::FivePoint => 5,
+        }
+    }
 }
 
 /// SplitMix64 (Steele, Lea and Flood 2014): a small, fast generator for RANSAC samples.
@@ -86,15 +108,24 @@ pub(crate) fn ransac_iterations(confidence: f64, inlier_ratio: f64, k: usize, ma
 /// A null vector of the `rows × 9` matrix `a` (row-major) of rank 8: Gauss–Jordan elimination
 /// with full pivoting, the free column set to 1. None when the rank is below 8.
 pub(crate) fn null_vector_9(a: &[[f64; 9]]) -> Option<[f64; 9]> {
+    let x = null_space_9(a, 8, 1e-12)?.pop()?;
+    let norm = x.iter().map(|v| v * v).sum::<f64>().sqrt();
+    Some(x.map(|v| v / norm))
+}
+
+/// The `9 − rank` null vectors of the `rows × 9` matrix `a` of rank `rank` by Gauss–Jordan
+/// elimination with full pivoting, one per free column (set to 1, the others 0; not
+/// normalised). None when a pivot falls below `tolerance` times the largest entry.
+pub(crate) fn null_space_9(a: &[[f64; 9]], rank: usize, tolerance: f64) -> Option<Vec<[f64; 9]>> {
     let mut m: Vec<[f64; 9]> = a.to_vec();
     let rows = m.len();
-    let mut pivot_cols = [usize::MAX; 8];
+    let mut pivot_cols = vec![usize::MAX; rank];
     let mut used = [false; 9];
     let scale = m
         .iter()
         .flat_map(|r| r.iter())
         .fold(0.0f64, |s, v| s.max(v.abs()));
-    if scale == 0.0 || rows < 8 {
+    if scale == 0.0 || rows < rank || rank > 8 {
         return None;
     }
     for (step, pivot_col) in pivot_cols.iter_mut().enumerate() {
@@ -107,7 +138,7 @@ pub(crate) fn null_vector_9(a: &[[f64; 9]]) -> Option<[f64; 9]> {
                 }
             }
         }
-        if best <= 1e-12 * scale {
+        if best <= tolerance * scale {
             return None;
         }
         m.swap(step, br);
@@ -127,14 +158,18 @@ pub(crate) fn null_vector_9(a: &[[f64; 9]]) -> Option<[f64; 9]> {
             }
         }
     }
-    let free = (0..9).find(|&c| !used[c])?;
-    let mut x = [0.0; 9];
-    x[free] = 1.0;
-    for (step, &c) in pivot_cols.iter().enumerate() {
-        x[c] = -m[step][free];
-    }
-    let norm = x.iter().map(|v| v * v).sum::<f64>().sqrt();
-    Some(x.map(|v| v / norm))
+    let null = (0..9)
+        .filter(|&c| !used[c])
+        .map(|free| {
+            let mut x = [0.0; 9];
+            x[free] = 1.0;
+            for (step, &c) in pivot_cols.iter().enumerate() {
+                x[c] = -m[step][free];
+            }
+            x
+        })
+        .collect();
+    Some(null)
 }
 
 /// The unit vector minimising `|A x|` for `A` given by its rows (least squares over more than
