@@ -78,14 +78,28 @@ pub const FACINGS: [[f32; 3]; 13] = [
     [1.0, -1.0, -1.0],
 ];
 
+/// An internode whose bark the level does not mesh (a thin chain its bark budget drops), drawn
+/// into the atlas instead: the cylinder from `start` to `end` of `diameter` (metres) seen along
+/// its quad's normal, in `color` (linear RGB, the bark's colour times its baked ambient light).
+#[derive(Clone, Copy, Debug, Default, PartialEq)]
+pub struct CloudWood {
+    pub start: [f32; 3],
+    pub end: [f32; 3],
+    pub diameter: f32,
+    pub color: [f32; 3],
+}
+
 /// The layout of a billboard cloud: quad k of the level's leaf mesh (vertices 4k … 4k + 3:
 /// base-left, base-right, tip-left, tip-right) is drawn from atlas rectangle `rects[k]` and
-/// stands for the finest level's cards `members[starts[k]..starts[k + 1]]`.
+/// stands for the elements `members[starts[k]..starts[k + 1]]`: the finest level's cards
+/// (indices below `num_cards`) and the dropped wood (index `num_cards + 2w` and
+/// `num_cards + 2w + 1` are [`Self::wood`]`[w]`, which is drawn into two quads of facings
+/// about perpendicular to it and to each other, so that no side view sees it only edge-on).
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct BillboardCloud {
     /// Per quad: x, y, width, height in atlas texels (y down, as the image's rows).
     pub rects: Vec<[u32; 4]>,
-    /// Indices of the finest level's cards, cluster by cluster.
+    /// Indices of the elements (cards, then wood), cluster by cluster.
     pub members: Vec<u32>,
     /// Where each quad's members start in [`Self::members`], and their end.
     pub starts: Vec<u32>,
@@ -93,6 +107,10 @@ pub struct BillboardCloud {
     pub atlas_size: [u32; 2],
     /// Side of a texel, metres.
     pub texel_m: f32,
+    /// Cards among the elements: members at or above it are wood.
+    pub num_cards: u32,
+    /// The wood drawn into the atlas.
+    pub wood: Vec<CloudWood>,
 }
 
 impl BillboardCloud {
@@ -102,6 +120,8 @@ impl BillboardCloud {
         self.starts.clear();
         self.atlas_size = [0, 0];
         self.texel_m = 0.0;
+        self.num_cards = 0;
+        self.wood.clear();
     }
 
     pub fn num_quads(&self) -> usize {
@@ -127,9 +147,63 @@ struct Frame {
     size: Vec2,
 }
 
+/// What a cloud clusters: the finest level's cards (4 vertices each), then two ribbons per
+/// internode of dropped wood (base-left, base-right, tip-left, tip-right, as a card's).
+#[derive(Clone, Copy)]
+struct Elements<'a> {
+    cards: &'a TreeMesh,
+    num_cards: usize,
+    ribbons: &'a [[Vec3; 4]],
+}
+
+impl Elements<'_> {
+    fn len(&self) -> usize {
+        self.num_cards + self.ribbons.len()
+    }
+
+    fn corner(&self, element: usize, k: usize) -> Vec3 {
+        if element < self.num_cards {
+            Vec3::from(self.cards.positions[4 * element + k])
+        } else {
+            self.ribbons[element - self.num_cards][k]
+        }
+    }
+}
+
+/// The two ribbons of `wood`: the cylinder's outline seen along the facing most perpendicular
+/// to its axis, and along the facing most perpendicular to both the axis and the first.
+fn ribbons_of(wood: &CloudWood) -> [[Vec3; 4]; 2] {
+    let (start, end) = (Vec3::from(wood.start), Vec3::from(wood.end));
+    let axis = (end - start).try_normalize().unwrap_or(Vec3::Y);
+    let facing = |k: usize| Vec3::from(FACINGS[k]).normalize();
+    let first = (0..FACINGS.len())
+        .min_by(|&a, &b| {
+            let off = |k: usize| facing(k).dot(axis).abs();
+            off(a).total_cmp(&off(b))
+        })
+        .unwrap_or(0);
+    let second = (0..FACINGS.len())
+        .filter(|&k| k != first)
+        .min_by(|&a, &b| {
+            let off = |k: usize| facing(k).dot(axis).abs() + facing(k).dot(facing(first)).abs();
+            off(a).total_cmp(&off(b))
+        })
+        .unwrap_or(first);
+    let radius = 0.5 * wood.diameter.max(0.0);
+    [first, second].map(|k| {
+        let side = facing(k)
+            .cross(axis)
+            .try_normalize()
+            .unwrap_or_else(|| super::any_perpendicular(axis))
+            * radius;
+        [start - side, start + side, end - side, end + side]
+    })
+}
+
 /// Working memory of [`build_cloud_into`].
 #[derive(Default)]
 pub(crate) struct CloudScratch {
+    ribbons: Vec<[Vec3; 4]>,
     cards: Vec<Card>,
     /// Facing (4 bits) and Morton code (27 bits) in the high 32 bits, card index in the low.
     keys: Vec<u64>,
@@ -142,11 +216,14 @@ pub(crate) struct CloudScratch {
 }
 
 /// A billboard cloud of at most `max_quads` quads standing for the cards of `cards` (quads of
-/// 4 vertices and 6 indices, card k's vertices at 4k): its quads into `out` (cleared first;
-/// uvs in the atlas, ambient 1 since the atlas carries the light), its layout into `cloud`.
-/// None reaches below y = `ground_y`.
+/// 4 vertices and 6 indices, card k's vertices at 4k) and for the internodes `wood` whose bark
+/// the level does not mesh: its quads into `out` (cleared first; uvs in the atlas, ambient 1
+/// since the atlas carries the light), its layout into `cloud`. None reaches below
+/// y = `ground_y`.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn build_cloud_into(
     cards: &TreeMesh,
+    wood: &[CloudWood],
     max_quads: usize,
     ground_y: f32,
     scratch: &mut CloudScratch,
@@ -155,18 +232,41 @@ pub(crate) fn build_cloud_into(
 ) {
     out.clear();
     cloud.clear();
-    let total = (cards.indices.len() / 6).min(cards.positions.len() / 4);
-    if total == 0 || max_quads == 0 {
+    let num_cards = (cards.indices.len() / 6).min(cards.positions.len() / 4);
+    if num_cards == 0 || max_quads == 0 {
         return;
     }
     let max_quads = max_quads.min(MAX_QUADS);
-    collect_cards(cards, total, scratch);
-    let by_facing = sort_keys(cards, scratch, true);
+    let mut ribbons = std::mem::take(&mut scratch.ribbons);
+    ribbons.clear();
+    ribbons.extend(wood.iter().flat_map(ribbons_of));
+    let elements = Elements {
+        cards,
+        num_cards,
+        ribbons: &ribbons,
+    };
+    cloud.num_cards = num_cards as u32;
+    cloud.wood.extend_from_slice(wood);
+    build_clusters(elements, max_quads, ground_y, scratch, cloud, out);
+    scratch.ribbons = ribbons;
+}
+
+/// [`build_cloud_into`] of `elements`, `cloud`'s wood already set.
+fn build_clusters(
+    elements: Elements,
+    max_quads: usize,
+    ground_y: f32,
+    scratch: &mut CloudScratch,
+    cloud: &mut BillboardCloud,
+    out: &mut TreeMesh,
+) {
+    collect_cards(elements, scratch);
+    let by_facing = sort_keys(elements, scratch, true);
     let floor_m = min_depth_m(&scratch.cards);
     let mut limit = smallest_limit(&scratch.codes, &scratch.depths, max_quads).max(floor_m);
     if count_clusters(&scratch.codes, &scratch.depths, limit) > max_quads && by_facing {
         // Fewer quads than facings: cluster by position alone.
-        sort_keys(cards, scratch, false);
+        sort_keys(elements, scratch, false);
         limit = smallest_limit(&scratch.codes, &scratch.depths, max_quads).max(floor_m);
     }
     scratch.clusters.clear();
@@ -188,7 +288,7 @@ pub(crate) fn build_cloud_into(
         let members = scratch.keys[start as usize..end as usize]
             .iter()
             .map(|&key| key as u32 as usize);
-        let frame = frame_of(cards, &scratch.cards, members, ground_y);
+        let frame = frame_of(elements, &scratch.cards, members, ground_y);
         scratch.frames.push(frame);
     }
     let Some(texel_m) = pack(&scratch.frames, &mut scratch.order, cloud) else {
@@ -223,17 +323,18 @@ pub(crate) fn build_cloud_into(
     }
 }
 
-/// Centre, facing and area of each of the first `total` cards.
-fn collect_cards(cards: &TreeMesh, total: usize, scratch: &mut CloudScratch) {
+/// Centre, facing and area of each element.
+fn collect_cards(elements: Elements, scratch: &mut CloudScratch) {
     scratch.cards.clear();
-    scratch.cards.extend((0..total).map(|card| {
-        let corner = |k: usize| Vec3::from(cards.positions[4 * card + k]);
+    scratch.cards.extend((0..elements.len()).map(|card| {
+        let corner = |k: usize| elements.corner(card, k);
         let center = (0..4).map(corner).sum::<Vec3>() * 0.25;
         let cross = (corner(1) - corner(0)).cross(corner(2) - corner(0));
-        let normal = cross
-            .try_normalize()
-            .or_else(|| Vec3::from(cards.normals[4 * card]).try_normalize())
-            .unwrap_or(Vec3::Z);
+        let fallback = (card < elements.num_cards)
+            .then(|| elements.cards.normals.get(4 * card).copied())
+            .flatten()
+            .and_then(|n| Vec3::from(n).try_normalize());
+        let normal = cross.try_normalize().or(fallback).unwrap_or(Vec3::Z);
         Card {
             center,
             normal,
@@ -256,7 +357,7 @@ fn facing_of(normal: Vec3) -> usize {
 
 /// Sorts the cards by facing (when `by_facing`) and Morton code into `keys` and `codes`;
 /// returns `by_facing`.
-fn sort_keys(mesh: &TreeMesh, scratch: &mut CloudScratch, by_facing: bool) -> bool {
+fn sort_keys(elements: Elements, scratch: &mut CloudScratch, by_facing: bool) -> bool {
     let (lo, hi) = scratch.cards.iter().fold(
         (Vec3::splat(f32::INFINITY), Vec3::splat(f32::NEG_INFINITY)),
         |(lo, hi), c| (lo.min(c.center), hi.max(c.center)),
@@ -308,7 +409,7 @@ fn sort_keys(mesh: &TreeMesh, scratch: &mut CloudScratch, by_facing: bool) -> bo
             scratch.cards[card].normal
         };
         (0..4).fold((f32::INFINITY, f32::NEG_INFINITY), |(lo, hi), k| {
-            let d = Vec3::from(mesh.positions[4 * card + k]).dot(depth);
+            let d = elements.corner(card, k).dot(depth);
             (lo.min(d), hi.max(d))
         })
     }));
@@ -467,7 +568,7 @@ fn fill_budget(
 /// The quad of a cluster: the plane through its members' area-weighted centre, normal to their
 /// mean facing, the bounding rectangle of their corners on it, clipped at the ground.
 fn frame_of(
-    mesh: &TreeMesh,
+    elements: Elements,
     cards: &[Card],
     members: impl Iterator<Item = usize> + Clone,
     ground_y: f32,
@@ -502,7 +603,7 @@ fn frame_of(
     let (mut lo, mut hi) = (Vec2::splat(f32::INFINITY), Vec2::splat(f32::NEG_INFINITY));
     for m in members {
         for k in 0..4 {
-            let d = Vec3::from(mesh.positions[4 * m + k]) - center;
+            let d = elements.corner(m, k) - center;
             let p = Vec2::new(d.dot(across), d.dot(along));
             lo = lo.min(p);
             hi = hi.max(p);
@@ -646,8 +747,25 @@ pub fn bake_atlas(
             )
         };
         let members = &cloud.members[cloud.starts[k] as usize..cloud.starts[k + 1] as usize];
+        let num_cards = cloud.num_cards as usize;
+        // Metres per texel on this quad (square texels).
+        let texel_m = ex2.sqrt() / rw as f32;
+        let mut rect = RectSamples {
+            width: rw_us,
+            height: rh_us,
+            masks: &mut masks,
+            colors: &mut colors,
+        };
         for &m in members {
             let m = m as usize;
+            if m >= num_cards {
+                if let Some(wood) = cloud.wood.get((m - num_cards) / 2) {
+                    let (a, b) = (to_rect(wood.start.into()), to_rect(wood.end.into()));
+                    let radius = 0.5 * wood.diameter / texel_m;
+                    rect.draw_capsule(a, b, radius, Vec3::from(wood.color));
+                }
+                continue;
+            }
             if 4 * m + 3 >= cards.positions.len() {
                 continue;
             }
@@ -673,7 +791,7 @@ pub fn bake_atlas(
                     for sy in 0..s {
                         for sx in 0..s {
                             let bit = 1u16 << (sy * s + sx);
-                            if masks[i] & bit != 0 {
+                            if rect.masks[i] & bit != 0 {
                                 continue;
                             }
                             let q = Vec2::new(
@@ -687,8 +805,8 @@ pub fn bake_atlas(
                                 continue;
                             }
                             if let Some(color) = texel(Vec2::new(a, 1.0 - b)) {
-                                masks[i] |= bit;
-                                colors[i] += color * light;
+                                rect.masks[i] |= bit;
+                                rect.colors[i] += color * light;
                             }
                         }
                     }
@@ -742,6 +860,61 @@ pub fn bake_atlas(
         }
     }
     atlas
+}
+
+/// The samples of one quad's rectangle while it is baked: per texel, which of its
+/// [`BAKE_SUBSAMPLES`]² samples are covered and the sum of their colours.
+struct RectSamples<'a> {
+    width: usize,
+    height: usize,
+    masks: &'a mut [u16],
+    colors: &'a mut [Vec3],
+}
+
+impl RectSamples<'_> {
+    /// Covers the samples within `radius` texels of the segment `a`–`b` (texel coordinates):
+    /// a cylinder seen from the side, its ends rounded (they meet the next internode's).
+    fn draw_capsule(&mut self, a: Vec2, b: Vec2, radius: f32, color: Vec3) {
+        if !(radius > 0.0) {
+            return;
+        }
+        let lo = a.min(b) - Vec2::splat(radius);
+        let hi = a.max(b) + Vec2::splat(radius);
+        let x0 = lo.x.floor().max(0.0) as usize;
+        let y0 = lo.y.floor().max(0.0) as usize;
+        let x1 = (hi.x.ceil().max(0.0) as usize).min(self.width);
+        let y1 = (hi.y.ceil().max(0.0) as usize).min(self.height);
+        let axis = b - a;
+        let length2 = axis.length_squared();
+        let radius2 = radius * radius;
+        let s = BAKE_SUBSAMPLES;
+        for ty in y0..y1 {
+            for tx in x0..x1 {
+                let i = ty * self.width + tx;
+                for sy in 0..s {
+                    for sx in 0..s {
+                        let bit = 1u16 << (sy * s + sx);
+                        if self.masks[i] & bit != 0 {
+                            continue;
+                        }
+                        let q = Vec2::new(
+                            tx as f32 + (sx as f32 + 0.5) / s as f32,
+                            ty as f32 + (sy as f32 + 0.5) / s as f32,
+                        );
+                        let t = if length2 > 0.0 {
+                            ((q - a).dot(axis) / length2).clamp(0.0, 1.0)
+                        } else {
+                            0.0
+                        };
+                        if (a + axis * t).distance_squared(q) <= radius2 {
+                            self.masks[i] |= bit;
+                            self.colors[i] += color;
+                        }
+                    }
+                }
+            }
+        }
+    }
 }
 
 /// [`bake_atlas`] of the coarsest level of `meshes`, if it is a billboard cloud, with the card
@@ -804,6 +977,7 @@ mod tests {
         let budget = total / 5;
         build_cloud_into(
             &cards,
+            &[],
             budget,
             ground_y,
             &mut CloudScratch::default(),
@@ -863,6 +1037,7 @@ mod tests {
         let (mut cloud, mut quads) = (BillboardCloud::default(), TreeMesh::default());
         build_cloud_into(
             &cards,
+            &[],
             4,
             0.0,
             &mut CloudScratch::default(),
@@ -880,6 +1055,64 @@ mod tests {
         let right = rect.get_pixel(3 * w / 4, h / 2);
         assert_eq!((left[3], right[3]), (255, 0));
         assert!(left[1] > left[0] && left[1] > left[2], "green: {left:?}");
+    }
+
+    #[test]
+    fn dropped_wood_is_baked_into_two_quads_that_see_it_from_about_perpendicular_sides() {
+        // One card, and a vertical internode 2 m off it that the level's bark leaves out.
+        let mut cards = TreeMesh::default();
+        let (p, n, uv, a) = cards.grow_vertices(4);
+        p.copy_from_slice(&[
+            [0.0, 1.0, 0.0],
+            [0.2, 1.0, 0.0],
+            [0.0, 1.4, 0.0],
+            [0.2, 1.4, 0.0],
+        ]);
+        n.fill([0.0, 0.0, 1.0]);
+        uv.copy_from_slice(&[[0.0, 1.0], [1.0, 1.0], [0.0, 0.0], [1.0, 0.0]]);
+        a.fill(1.0);
+        push_quad_indices(&mut cards, 0, 1);
+        let wood = CloudWood {
+            start: [2.0, 0.5, 1.0],
+            end: [2.0, 2.5, 1.0],
+            diameter: 0.1,
+            color: [0.3, 0.2, 0.1],
+        };
+        let texture = RgbaImage::from_pixel(8, 8, Rgba([40, 120, 30, 255]));
+        let (mut cloud, mut quads) = (BillboardCloud::default(), TreeMesh::default());
+        build_cloud_into(
+            &cards,
+            &[wood],
+            8,
+            0.0,
+            &mut CloudScratch::default(),
+            &mut cloud,
+            &mut quads,
+        );
+        assert_eq!(cloud.num_quads(), 3, "the card's quad and the wood's two");
+        let atlas = bake_atlas(&cloud, &quads, &cards, &texture);
+        let mut normals = Vec::new();
+        for k in 0..cloud.num_quads() {
+            let members = &cloud.members[cloud.starts[k] as usize..cloud.starts[k + 1] as usize];
+            if members != [1] && members != [2] {
+                continue;
+            }
+            let normal = Vec3::from(quads.normals[4 * k]);
+            assert!(normal.y.abs() < 1e-3, "a vertical stem's quad faces {normal}");
+            normals.push(normal);
+            // The quad is the stem's outline seen along its normal: 2 m by 10 cm, all of it
+            // opaque but the rounded ends.
+            let [x, y, w, h] = cloud.rects[k];
+            let size = Vec2::new(w as f32, h as f32) * cloud.texel_m;
+            assert!((size.y - 2.0).abs() < 0.02 && (size.x - 0.1).abs() < 0.02, "{size}");
+            let rect = image::imageops::crop_imm(&atlas, x, y, w, h).to_image();
+            let opaque = AlphaMask::from_texture(&rect).opaque_fraction();
+            assert!(opaque > 0.85, "{opaque} of the stem's quad opaque");
+            let middle = rect.get_pixel(w / 2, h / 2);
+            assert!(middle[0] > middle[1] && middle[1] > middle[2], "bark: {middle:?}");
+        }
+        assert_eq!(normals.len(), 2, "the wood is drawn in two quads");
+        assert!(normals[0].dot(normals[1]).abs() < 0.1, "{normals:?}");
     }
 
     #[test]

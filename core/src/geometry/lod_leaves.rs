@@ -39,10 +39,13 @@ pub(crate) struct MergeScratch {
 /// The leaves of coarse level `lod` (its branches already meshed), at most `num_quads` quads
 /// standing for all the cards of `cards`, the finest level's: the coarsest level a billboard
 /// cloud ([`billboard_cloud`]), which keeps the gaps between a cluster's leaves, the others
-/// merged cards ([`merge_cards_into`]), which the species' leaf texture draws. Sets the level's
-/// leaf index count.
+/// merged cards ([`merge_cards_into`]), which the species' leaf texture draws. The cloud's atlas
+/// also draws `wood`, the internodes whose bark the level does not mesh. Sets the level's leaf
+/// index count.
+#[allow(clippy::too_many_arguments)]
 pub(crate) fn coarse_leaves_into(
     cards: &TreeMesh,
+    wood: &[billboard_cloud::CloudWood],
     num_quads: usize,
     ground_y: f32,
     coarsest: bool,
@@ -53,6 +56,7 @@ pub(crate) fn coarse_leaves_into(
         let cloud = lod.billboards.get_or_insert_with(Default::default);
         billboard_cloud::build_cloud_into(
             cards,
+            wood,
             num_quads,
             ground_y,
             &mut scratch.cloud,

@@ -4,6 +4,7 @@
 
 use glam::Vec3;
 
+use super::billboard_cloud::CloudWood;
 use super::branches::RingFrames;
 use super::leaves::{self, LeafScratch};
 use super::lod_leaves::{self, MergeScratch};
@@ -46,6 +47,8 @@ pub struct Mesher {
     leaf_scratch: LeafScratch,
     merge_scratch: MergeScratch,
     kept: Vec<bool>,
+    /// The internodes of the chains the coarsest level drops, for its billboard cloud's atlas.
+    dropped_wood: Vec<CloudWood>,
     /// Centres of the fruit, in arena and bud order.
     fruit_centers: Vec<Vec3>,
     /// Parents and children of the internodes, for the topology.
@@ -117,11 +120,17 @@ impl Mesher {
                 lod.billboards = None;
                 lod.num_leaf_indices = 6 * num_cards;
             } else {
+                let cloud = level + 1 == LOD_TRIANGLE_FRACTIONS.len() && !self.coarsest_as_cards;
+                self.dropped_wood.clear();
+                if cloud {
+                    self.collect_dropped_wood(params.bark_color, ambient);
+                }
                 lod_leaves::coarse_leaves_into(
                     &meshes.leaves,
+                    &self.dropped_wood,
                     num_cards,
                     ground_y,
-                    level + 1 == LOD_TRIANGLE_FRACTIONS.len() && !self.coarsest_as_cards,
+                    cloud,
                     &mut self.merge_scratch,
                     lod,
                 );
@@ -151,6 +160,26 @@ impl Mesher {
             self.links.push(node);
             if let Some(fruit) = fruit {
                 leaves::fruit_centers(node, index as u32, fruit, &mut self.fruit_centers);
+            }
+        }
+    }
+
+    /// The internodes of the chains the last coarse level meshed leaves out (`kept`), in the
+    /// bark's colour times its baked ambient light at their middle, into `dropped_wood`.
+    fn collect_dropped_wood(&mut self, bark_color: [f32; 3], ambient: AmbientFn) {
+        for (chain, &kept) in self.kept.iter().enumerate() {
+            if kept {
+                continue;
+            }
+            for &node in self.topology.nodes_of(chain) {
+                let node = &self.nodes[node as usize];
+                let light = crate::export::ambient_color(ambient(0.5 * (node.start + node.end)));
+                self.dropped_wood.push(CloudWood {
+                    start: node.start.to_array(),
+                    end: node.end.to_array(),
+                    diameter: node.diameter,
+                    color: bark_color.map(|c| c * light),
+                });
             }
         }
     }
