@@ -318,7 +318,7 @@ fn design_step(
                 design.apply(&InputEvent::Undo);
             }
         }
-        90 if cycle % 4 == 0 => design.apply(&InputEvent::Grow { iterations: 2 }),
+        90 if cycle.is_multiple_of(4) => design.apply(&InputEvent::Grow { iterations: 2 }),
         120 if cycle % 7 == 3 => design.apply(&InputEvent::Undo),
         _ => {}
     }

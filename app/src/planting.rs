@@ -334,7 +334,11 @@ impl DesignState {
     /// The status line: the scale's source and uncertainty, and what the tree is drawn at.
     pub fn scale_status(&self) -> String {
         match self.is_planted() {
-            true => format!("{} · {}", self.scale.state.status(), self.tree_scale.status()),
+            true => format!(
+                "{} · {}",
+                self.scale.state.status(),
+                self.tree_scale.status()
+            ),
             false => self.scale.state.status(),
         }
     }
@@ -394,7 +398,10 @@ mod tests {
                 let point_in_world = world_from_tree.transform_point3(point_in_tree);
                 let a = tree_camera.pixel_from_world(point_in_tree).unwrap();
                 let b = camera.pixel_from_world(point_in_world).unwrap();
-                assert!(a.distance(b) < 1e-3, "{a} vs {b} at {metres_per_unit} m/unit");
+                assert!(
+                    a.distance(b) < 1e-3,
+                    "{a} vs {b} at {metres_per_unit} m/unit"
+                );
                 // Depths in tree space are metres: the world's depth times the scale.
                 let depth_m = tree_camera.depth_of(point_in_tree);
                 let depth_units = camera.depth_of(point_in_world);

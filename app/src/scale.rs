@@ -78,9 +78,9 @@ impl TreeScale {
                 "Tree at the tracker's unit (no metric scale)".into()
             }
             TreeScale::Metric(scale) => format!("Tree at metric scale from {scale}"),
-            TreeScale::Restored { metres_per_unit } => format!(
-                "Tree at its restored placement's scale ({metres_per_unit:.3} m per unit)"
-            ),
+            TreeScale::Restored { metres_per_unit } => {
+                format!("Tree at its restored placement's scale ({metres_per_unit:.3} m per unit)")
+            }
         }
     }
 }

@@ -201,7 +201,10 @@ fn a_tree_grown_in_a_world_1_6_times_too_large_has_its_metric_height_in_the_true
         grown.true_height_m(&truth_from_tracked),
         100.0 * (scale_error - 1.0)
     );
-    assert!(grown.height_m() > 1.0, "a {YEARS}-year tree is taller than 1 m");
+    assert!(
+        grown.height_m() > 1.0,
+        "a {YEARS}-year tree is taller than 1 m"
+    );
     assert!(
         (ratio / scale_error - 1.0).abs() < 1e-3,
         "true over metric height {ratio:.4}, the camera-height scale's error {scale_error:.4}"
@@ -225,7 +228,10 @@ fn a_tree_grown_in_a_world_1_6_times_too_large_has_its_metric_height_in_the_true
     // A new holding height rescales the grown tree about its base: the base stays where it was
     // tapped, the tree keeps its metric size, its size in the world goes as 1 / scale.
     let after = stands.last().cloned().flatten().expect("planted");
-    assert_eq!(after.tree_sha256, grown.tree_sha256, "rescaling is not growing");
+    assert_eq!(
+        after.tree_sha256, grown.tree_sha256,
+        "rescaling is not growing"
+    );
     assert!(
         after.base_in_world.distance(grown.base_in_world) < 1e-5,
         "the base moved from {} to {}",

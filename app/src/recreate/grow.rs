@@ -347,19 +347,18 @@ fn shallowest_near_best(scores: &[f64], tolerance: f64) -> Option<usize> {
 ///
 /// The tree grows in metres whatever the world's unit: the hull, the points and the measures
 /// (in the world's units, `metres_per_unit` metres each) are mapped into tree space with the
-/// scale, and the returned `world_from_tree` carries `S(1 / metres_per_unit)`.
+/// scale by `world_from_tree` (from [`world_from_tree`]: it carries `S(1 / metres_per_unit)`),
+/// which is returned with the tree.
 pub fn grow_into_hull(
     species: Species,
     species_choice: String,
     seed: u64,
     recreation: &Recreation,
     guide: Guide,
-    up: DVec3,
+    world_from_tree: Affine3A,
     max_years: f32,
-    metres_per_unit: f64,
 ) -> (Tree, Affine3A, GrowthReport) {
     let Guide { crown, coverage } = guide;
-    let world_from_tree = world_from_tree(recreation.base, up, metres_per_unit);
     let tree_from_world = world_from_tree.inverse();
     // Metres per world unit as the placement has it (1 where the scale was not usable).
     let metres = 1.0 / f64::from(world_from_tree.matrix3.x_axis.length());

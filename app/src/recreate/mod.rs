@@ -166,9 +166,8 @@ pub fn recreate(
             crown: Some(&crown),
             coverage: Some(coverage),
         },
-        footage.ground.normal,
+        placed,
         max_years,
-        metres_per_unit,
     );
     let mut tree = tree;
     if let Some(found) = &trunk {

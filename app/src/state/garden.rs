@@ -500,7 +500,7 @@ impl DesignState {
         let map = *world_from_old;
         let garden = &mut self.garden;
         if garden.stand.is_some() {
-            garden.garden_from_world = garden.garden_from_world * map.inverse();
+            garden.garden_from_world *= map.inverse();
         }
         let place = |stand: &mut Stand| {
             for m in &mut stand.members {

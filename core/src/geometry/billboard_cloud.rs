@@ -875,7 +875,8 @@ impl RectSamples<'_> {
     /// Covers the samples within `radius` texels of the segment `a`–`b` (texel coordinates):
     /// a cylinder seen from the side, its ends rounded (they meet the next internode's).
     fn draw_capsule(&mut self, a: Vec2, b: Vec2, radius: f32, color: Vec3) {
-        if !(radius > 0.0) {
+        // NaN radii draw nothing too.
+        if radius.is_nan() || radius <= 0.0 {
             return;
         }
         let lo = a.min(b) - Vec2::splat(radius);
@@ -1098,18 +1099,27 @@ mod tests {
                 continue;
             }
             let normal = Vec3::from(quads.normals[4 * k]);
-            assert!(normal.y.abs() < 1e-3, "a vertical stem's quad faces {normal}");
+            assert!(
+                normal.y.abs() < 1e-3,
+                "a vertical stem's quad faces {normal}"
+            );
             normals.push(normal);
             // The quad is the stem's outline seen along its normal: 2 m by 10 cm, all of it
             // opaque but the rounded ends.
             let [x, y, w, h] = cloud.rects[k];
             let size = Vec2::new(w as f32, h as f32) * cloud.texel_m;
-            assert!((size.y - 2.0).abs() < 0.02 && (size.x - 0.1).abs() < 0.02, "{size}");
+            assert!(
+                (size.y - 2.0).abs() < 0.02 && (size.x - 0.1).abs() < 0.02,
+                "{size}"
+            );
             let rect = image::imageops::crop_imm(&atlas, x, y, w, h).to_image();
             let opaque = AlphaMask::from_texture(&rect).opaque_fraction();
             assert!(opaque > 0.85, "{opaque} of the stem's quad opaque");
             let middle = rect.get_pixel(w / 2, h / 2);
-            assert!(middle[0] > middle[1] && middle[1] > middle[2], "bark: {middle:?}");
+            assert!(
+                middle[0] > middle[1] && middle[1] > middle[2],
+                "bark: {middle:?}"
+            );
         }
         assert_eq!(normals.len(), 2, "the wood is drawn in two quads");
         assert!(normals[0].dot(normals[1]).abs() < 0.1, "{normals:?}");
