@@ -1011,10 +1011,8 @@ mod tests {
         }
     }
 
-    #[test]
-    fn a_quad_per_card_bakes_the_card_texture_coverage() {
-        // One flat card facing +Z: its quad is the card and the atlas holds its texture's
-        // opaque share.
+    /// One flat 0.2 × 0.4 m card facing +Z, 1 m above the ground.
+    fn one_card_facing_z() -> TreeMesh {
         let mut cards = TreeMesh::default();
         let (p, n, uv, a) = cards.grow_vertices(4);
         p.copy_from_slice(&[
@@ -1027,6 +1025,14 @@ mod tests {
         uv.copy_from_slice(&[[0.0, 1.0], [1.0, 1.0], [0.0, 0.0], [1.0, 0.0]]);
         a.fill(1.0);
         push_quad_indices(&mut cards, 0, 1);
+        cards
+    }
+
+    #[test]
+    fn a_quad_per_card_bakes_the_card_texture_coverage() {
+        // One flat card facing +Z: its quad is the card and the atlas holds its texture's
+        // opaque share.
+        let cards = one_card_facing_z();
         // A texture whose left half is opaque.
         let texture = RgbaImage::from_fn(64, 64, |x, _| {
             if x < 32 {
@@ -1061,18 +1067,7 @@ mod tests {
     #[test]
     fn dropped_wood_is_baked_into_two_quads_that_see_it_from_about_perpendicular_sides() {
         // One card, and a vertical internode 2 m off it that the level's bark leaves out.
-        let mut cards = TreeMesh::default();
-        let (p, n, uv, a) = cards.grow_vertices(4);
-        p.copy_from_slice(&[
-            [0.0, 1.0, 0.0],
-            [0.2, 1.0, 0.0],
-            [0.0, 1.4, 0.0],
-            [0.2, 1.4, 0.0],
-        ]);
-        n.fill([0.0, 0.0, 1.0]);
-        uv.copy_from_slice(&[[0.0, 1.0], [1.0, 1.0], [0.0, 0.0], [1.0, 0.0]]);
-        a.fill(1.0);
-        push_quad_indices(&mut cards, 0, 1);
+        let cards = one_card_facing_z();
         let wood = CloudWood {
             start: [2.0, 0.5, 1.0],
             end: [2.0, 2.5, 1.0],
